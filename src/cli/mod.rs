@@ -1,0 +1,63 @@
+//! The command-line interface: argument parsing and printing, over the library's stages.
+//!
+//! Exit status: 0 when everything asked for succeeded, 1 when some design failed (the others
+//! are still reported), 2 for a usage error or a failure that stops the whole command.
+
+mod bench;
+mod mass;
+mod pipeline;
+mod study;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(
+    name = "rodstudy",
+    version,
+    about = "Connecting-rod design studies: mass properties from STL, crank–slider pin forces, tet10 FEM"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Mass properties of STL designs (files or folders): volume, mass, centroid, inertia,
+    /// principal axes, and l1, offset, I_zz, I_xx in the mechanism frame.
+    Mass(mass::MassArgs),
+    /// Run every stage that exists on every design of a folder and write the reports.
+    Study(study::StudyArgs),
+    /// Benchmarks, reported as ratios against a reference run in the same process.
+    #[command(subcommand)]
+    Bench(bench::BenchCommand),
+    /// Create (or check) the project-local Python environment the pipeline scripts use.
+    Setup,
+    /// Run a script of `pipeline/` with the project's Python environment.
+    Pipeline(pipeline::PipelineArgs),
+}
+
+/// Parses the command line, runs the command, prints errors; returns the exit status.
+pub fn main() -> i32 {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            let _ = e.print();
+            return if e.use_stderr() { 2 } else { 0 };
+        }
+    };
+    let result = match cli.command {
+        Command::Mass(args) => mass::run(args),
+        Command::Study(args) => study::run(args),
+        Command::Bench(command) => bench::run(command),
+        Command::Setup => pipeline::setup(),
+        Command::Pipeline(args) => pipeline::run(args),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            2
+        }
+    }
+}

@@ -1,0 +1,42 @@
+//! `rodstudy study [--designs DIR] [--out DIR]`
+
+use crate::study::{run_study, tables::mass_table, write_reports};
+use anyhow::Result;
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Args)]
+pub struct StudyArgs {
+    /// Folder of designs (`*.stl`, each with an optional sidecar `.toml`).
+    #[arg(long, default_value = "designs")]
+    designs: PathBuf,
+    /// Folder the reports are written to.
+    #[arg(long, default_value = "reports")]
+    out: PathBuf,
+}
+
+pub fn run(args: StudyArgs) -> Result<i32> {
+    let results = run_study(&args.designs)?;
+    eprintln!(
+        "study: ran {} on {} design(s) in {}; not yet available: {}",
+        results.stages_run.join(", "),
+        results.designs.len() + results.failed.len(),
+        args.designs.display(),
+        results.stages_not_yet_available.join(", ")
+    );
+    let designs: Vec<_> = results.designs.iter().map(|d| &d.mass).collect();
+    print!("{}", mass_table(&designs));
+    for d in &designs {
+        for w in &d.warnings {
+            eprintln!("warning: {}: {w}", d.file);
+        }
+    }
+    for f in &results.failed {
+        eprintln!("FAILED {}: {}", f.file, f.error);
+    }
+    let written = write_reports(&results, &args.out)?;
+    for path in written {
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(i32::from(!results.failed.is_empty()))
+}

@@ -1,0 +1,192 @@
+//! The optional sidecar `NAME.toml` beside `NAME.stl` (SPEC "Sidecar").
+//!
+//! Keys: `name` (display name), `units` (`mm` default, `cm`, `m`, `in`), `density` (kg/m³,
+//! default 7800), `crank_pin` and `piston_pin` (pin centres in file units; default the spec's
+//! mechanism, A at the origin and B 180 mm along x, expressed in the file's units), `pin_axis`
+//! (`"x"`, `"y"`, `"z"` (default) or a vector `[ax, ay, az]`). Unknown keys and wrong types are
+//! errors, so a typo never silently falls back to a default.
+
+use anyhow::{Context, Result, bail};
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// Length unit of an STL file's coordinates.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Units {
+    #[default]
+    Mm,
+    Cm,
+    M,
+    In,
+}
+
+impl Units {
+    /// Metres per file unit.
+    pub fn to_metres(self) -> f64 {
+        match self {
+            Units::Mm => 1e-3,
+            Units::Cm => 1e-2,
+            Units::M => 1.0,
+            Units::In => 0.0254,
+        }
+    }
+
+    pub fn symbol(self) -> &'static str {
+        match self {
+            Units::Mm => "mm",
+            Units::Cm => "cm",
+            Units::M => "m",
+            Units::In => "in",
+        }
+    }
+}
+
+/// The pin axis: a coordinate axis by name or any non-zero vector.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(untagged)]
+pub enum PinAxis {
+    Named(String),
+    Vector([f64; 3]),
+}
+
+impl Default for PinAxis {
+    fn default() -> Self {
+        PinAxis::Named("z".into())
+    }
+}
+
+/// Density of steel used when the sidecar gives none [kg/m³] (SPEC "Stage 1").
+pub const DEFAULT_DENSITY: f64 = 7800.0;
+/// The spec's centre distance A→B [m], the default position of the piston pin.
+pub const DEFAULT_CENTRE_DISTANCE: f64 = 0.18;
+
+/// Contents of a sidecar file, as written (file units).
+#[derive(Debug, Clone, PartialEq, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Sidecar {
+    pub name: Option<String>,
+    #[serde(default)]
+    pub units: Units,
+    pub density: Option<f64>,
+    pub crank_pin: Option<[f64; 3]>,
+    pub piston_pin: Option<[f64; 3]>,
+    #[serde(default)]
+    pub pin_axis: PinAxis,
+}
+
+/// The sidecar with every default filled in and every value checked, in SI units.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DesignSettings {
+    pub name: Option<String>,
+    pub units: Units,
+    pub density: f64,
+    pub crank_pin_m: Vector3<f64>,
+    pub piston_pin_m: Vector3<f64>,
+    pub pin_axis: Vector3<f64>,
+    /// The sidecar file read, if there was one.
+    pub source: Option<PathBuf>,
+}
+
+/// Path of the sidecar that belongs to `stl` (same stem, `.toml`).
+pub fn sidecar_path(stl: &Path) -> PathBuf {
+    stl.with_extension("toml")
+}
+
+impl DesignSettings {
+    /// Reads the sidecar beside `stl` if it exists, else the spec's defaults.
+    pub fn for_stl(stl: &Path) -> Result<Self> {
+        let path = sidecar_path(stl);
+        if !path.exists() {
+            return Sidecar::default().resolve(None);
+        }
+        let text = std::fs::read_to_string(&path)
+            .with_context(|| format!("{}: cannot read the sidecar", path.display()))?;
+        let sidecar: Sidecar = toml::from_str(&text)
+            .with_context(|| format!("{}: invalid sidecar", path.display()))?;
+        sidecar
+            .resolve(Some(path.clone()))
+            .with_context(|| format!("{}: invalid sidecar", path.display()))
+    }
+}
+
+impl Sidecar {
+    /// Fills in defaults, checks the values and converts the pins to metres.
+    pub fn resolve(self, source: Option<PathBuf>) -> Result<DesignSettings> {
+        let scale = self.units.to_metres();
+        let density = self.density.unwrap_or(DEFAULT_DENSITY);
+        if !(density.is_finite() && density > 0.0) {
+            bail!("`density` must be a positive number of kg/m³, got {density}");
+        }
+        let crank = Vector3::from(self.crank_pin.unwrap_or([0.0; 3]));
+        let piston = match self.piston_pin {
+            Some(p) => Vector3::from(p),
+            None => crank + Vector3::x() * (DEFAULT_CENTRE_DISTANCE / scale),
+        };
+        for (key, p) in [("crank_pin", crank), ("piston_pin", piston)] {
+            if !p.iter().all(|c| c.is_finite()) {
+                bail!("`{key}` must have finite coordinates, got {p:?}");
+            }
+        }
+        let axis = match &self.pin_axis {
+            PinAxis::Named(n) => match n.as_str() {
+                "x" => Vector3::x(),
+                "y" => Vector3::y(),
+                "z" => Vector3::z(),
+                other => {
+                    bail!("`pin_axis` must be \"x\", \"y\", \"z\" or [ax, ay, az], got {other:?}")
+                }
+            },
+            PinAxis::Vector(v) => {
+                let v = Vector3::from(*v);
+                if !(v.iter().all(|c| c.is_finite()) && v.norm() > 0.0) {
+                    bail!("`pin_axis` must be a non-zero finite vector, got {v:?}");
+                }
+                v.normalize()
+            }
+        };
+        Ok(DesignSettings {
+            name: self.name,
+            units: self.units,
+            density,
+            crank_pin_m: crank * scale,
+            piston_pin_m: piston * scale,
+            pin_axis: axis,
+            source,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_the_spec_mechanism() {
+        let s = Sidecar::default().resolve(None).unwrap();
+        assert_eq!(s.density, 7800.0);
+        assert_eq!(s.crank_pin_m, Vector3::zeros());
+        assert!((s.piston_pin_m - Vector3::new(0.18, 0.0, 0.0)).norm() < 1e-15);
+        assert_eq!(s.pin_axis, Vector3::z());
+    }
+
+    #[test]
+    fn metres_keep_the_default_centre_distance() {
+        let s: Sidecar = toml::from_str("units = \"m\"").unwrap();
+        let s = s.resolve(None).unwrap();
+        assert!((s.piston_pin_m.x - 0.18).abs() < 1e-15);
+    }
+
+    #[test]
+    fn unknown_keys_and_wrong_types_are_refused() {
+        let err = toml::from_str::<Sidecar>("densty = 7000.0").unwrap_err();
+        assert!(err.to_string().contains("unknown field `densty`"), "{err}");
+        assert!(toml::from_str::<Sidecar>("density = \"heavy\"").is_err());
+        assert!(toml::from_str::<Sidecar>("units = \"furlong\"").is_err());
+        let bad: Sidecar = toml::from_str("density = -1.0").unwrap();
+        assert!(bad.resolve(None).is_err());
+        let bad: Sidecar = toml::from_str("pin_axis = \"w\"").unwrap();
+        assert!(bad.resolve(None).is_err());
+    }
+}

@@ -1,0 +1,16 @@
+//! rodstudy: connecting-rod design studies.
+//!
+//! The modules follow the pipeline of the study (see `SPEC.md` and the thesis in `shared/seed`):
+//!
+//! - [`geometry`]: stage 1, reading STL, validating the solid, exact mass properties and the
+//!   mapping into the mechanism frame;
+//! - [`study`]: running the stages over every design of a folder;
+//! - [`python_env`]: the project-local Python environment the `pipeline/` scripts run in;
+//! - [`bench`]: benchmarks, reported as ratios against a reference run;
+//! - [`cli`]: the command-line interface the binary is a thin front over.
+
+pub mod bench;
+pub mod cli;
+pub mod geometry;
+pub mod python_env;
+pub mod study;

@@ -1,0 +1,5 @@
+//! Thin command-line front over the `rodstudy` library: parse, dispatch, exit status.
+
+fn main() {
+    std::process::exit(rodstudy::cli::main());
+}
