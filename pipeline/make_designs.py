@@ -104,7 +104,7 @@ MESH_OPTIONS = {
     "General.NumThreads": 1,
     "Geometry.OCCParallel": 0,
     "Mesh.Algorithm": 6,  # Frontal-Delaunay for surfaces
-    "Mesh.MeshSizeFromCurvature": 150,  # elements per 2*pi of curvature
+    "Mesh.MeshSizeFromCurvature": 240,  # elements per 2*pi of curvature
     "Mesh.MeshSizeMin": 0.4,
     "Mesh.MeshSizeMax": 3.0,
     "Mesh.MeshSizeExtendFromBoundary": 1,
@@ -263,7 +263,7 @@ def z_parallel_edges(volume: int):
     out = []
     for c in curves:
         x0, y0, _, x1, y1, _ = occ.getBoundingBox(1, c)
-        if abs(x1 - x0) < 1e-7 and abs(y1 - y0) < 1e-7 and abs(y0) > 1e-6:
+        if abs(x1 - x0) < 1e-5 and abs(y1 - y0) < 1e-5 and abs(y0 + y1) > 1e-3:
             out.append((c, x0, y0))
     return out
 

@@ -83,11 +83,13 @@ fn detect_format(bytes: &[u8]) -> Result<StlFormat, MeshError> {
         return Ok(StlFormat::Ascii);
     }
     match declared {
-        Some(n) if actual < 84 + 50 * n => Err(MeshError::Truncated {
-            declared: n,
-            expected: 84 + 50 * n,
-            actual,
-        }),
+        Some(n) if actual < 84 + 50 * n && first_record_is_plausible(bytes) => {
+            Err(MeshError::Truncated {
+                declared: n,
+                expected: 84 + 50 * n,
+                actual,
+            })
+        }
         Some(n) => Err(MeshError::NotStl(format!(
             "not ASCII (no leading 'solid') and not binary (the header declares {n} triangles = {} bytes, the file has {actual})",
             84 + 50 * n
@@ -96,6 +98,16 @@ fn detect_format(bytes: &[u8]) -> Result<StlFormat, MeshError> {
             "{actual} bytes is too short for a binary STL (84-byte minimum) and the file does not start with 'solid'"
         ))),
     }
+}
+
+/// Whether the first 50-byte triangle record of a would-be binary STL holds ordinary floats
+/// (finite, below 1e9 in magnitude), which tells a cut-off STL from some other file.
+fn first_record_is_plausible(bytes: &[u8]) -> bool {
+    bytes.len() >= 84 + 50
+        && bytes[84..132].chunks_exact(4).all(|c| {
+            let x = f32::from_le_bytes([c[0], c[1], c[2], c[3]]);
+            x.is_finite() && x.abs() < 1e9
+        })
 }
 
 /// `stl_io` requires `solid NAME` at the very start; leading blanks are dropped and a first
@@ -161,6 +173,7 @@ mod tests {
     fn truncated_binary_names_the_sizes() {
         let mut bytes = binary(b"x", &[TRI, TRI, TRI]);
         bytes.truncate(84 + 120);
+        assert!(first_record_is_plausible(&bytes));
         let err = parse_stl(bytes).unwrap_err();
         assert!(matches!(
             err,
@@ -196,8 +209,16 @@ mod tests {
             parse_stl(b"hello".to_vec()),
             Err(MeshError::NotStl(_))
         ));
-        let png = [&b"\x89PNG\r\n\x1a\n"[..], &[7u8; 300][..]].concat();
+        // A compressed file: header then pseudo-random bytes.
+        let mut state = 12345u32;
+        let noise = (0..4000).map(|_| {
+            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (state >> 24) as u8
+        });
+        let png: Vec<u8> = b"\x89PNG\r\n\x1a\n".iter().copied().chain(noise).collect();
         assert!(matches!(parse_stl(png), Err(MeshError::NotStl(_))));
+        let text = "This is a README, not a mesh. ".repeat(10).into_bytes();
+        assert!(matches!(parse_stl(text), Err(MeshError::NotStl(_))));
         assert!(matches!(
             parse_stl(binary(b"x", &[])),
             Err(MeshError::NoTriangles)

@@ -180,3 +180,142 @@ fn check_one_shell(mesh: &IndexedMesh, pairs: &[(u32, u32)]) -> Result<(), MeshE
         at: Location::from(mesh.vertices[mesh.triangles[example][0] as usize]),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::primitives::{cuboid, flipped, torus, transformed, voxel_rod};
+    use nalgebra::{Matrix3, Vector3};
+
+    fn unit_box() -> IndexedMesh {
+        cuboid(Vector3::new(1.0, 2.0, 3.0), Vector3::zeros())
+    }
+
+    /// Two meshes side by side as one (indices of the second shifted).
+    fn union(a: &IndexedMesh, b: &IndexedMesh) -> IndexedMesh {
+        let offset = a.vertices.len() as u32;
+        let mut m = a.clone();
+        m.vertices.extend(&b.vertices);
+        m.triangles
+            .extend(b.triangles.iter().map(|t| t.map(|i| i + offset)));
+        m
+    }
+
+    #[test]
+    fn valid_solids_pass_untouched() {
+        for mesh in [unit_box(), torus(1.0, 0.3, 24, 12), voxel_rod().0] {
+            let v = validate(mesh.clone()).unwrap();
+            assert!(v.warnings.is_empty());
+            assert_eq!(v.mesh, mesh);
+        }
+    }
+
+    #[test]
+    fn inverted_mesh_is_flipped_with_a_warning() {
+        let v = validate(flipped(&voxel_rod().0)).unwrap();
+        assert_eq!(v.warnings.len(), 1);
+        assert!(v.warnings[0].contains("flipped"));
+        assert!(signed_volume(&v.mesh) > 0.0);
+    }
+
+    #[test]
+    fn open_mesh_is_refused_with_count_and_location() {
+        let mut m = unit_box();
+        m.triangles.pop();
+        let err = validate(m).unwrap_err();
+        assert!(matches!(err, MeshError::Open { count: 3, .. }), "{err}");
+        assert!(
+            err.to_string().contains("open mesh: 3 boundary edge(s)"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn one_flipped_triangle_is_inconsistent_orientation() {
+        let mut m = torus(1.0, 0.3, 24, 12);
+        m.triangles[7].swap(0, 1);
+        let err = validate(m).unwrap_err();
+        assert!(
+            matches!(err, MeshError::Inconsistent { count: 3, .. }),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn boxes_sharing_an_edge_are_non_manifold() {
+        // Two cubes touching along one edge: that edge is used by four triangles.
+        let a = cuboid(Vector3::repeat(1.0), Vector3::zeros());
+        let b = cuboid(Vector3::repeat(1.0), Vector3::new(1.0, 1.0, 0.0));
+        let mut m = union(&a, &b);
+        // Weld the shared corners so the edge is one edge of the mesh.
+        m = crate::geometry::weld::weld(&crate::geometry::primitives::to_soup(&m));
+        let err = validate(m).unwrap_err();
+        assert!(
+            matches!(err, MeshError::NonManifold { faces: 4, .. }),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn two_separate_solids_are_two_shells() {
+        let a = unit_box();
+        let b = transformed(
+            &unit_box(),
+            &Matrix3::identity(),
+            Vector3::new(5.0, 0.0, 0.0),
+        );
+        let err = validate(union(&a, &b)).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                MeshError::MultipleShells {
+                    count: 2,
+                    triangles: 12,
+                    ..
+                }
+            ),
+            "{err}"
+        );
+        assert!(
+            err.to_string().contains("(5.5"),
+            "location of the second shell: {err}"
+        );
+    }
+
+    #[test]
+    fn degenerate_triangles_are_refused() {
+        let mut m = unit_box();
+        m.triangles[0][1] = m.triangles[0][0];
+        assert!(matches!(
+            validate(m).unwrap_err(),
+            MeshError::Degenerate {
+                count: 1,
+                triangle: 0,
+                ..
+            }
+        ));
+        // Collinear corners: a zero-area sliver added into an otherwise closed box.
+        let mut m = unit_box();
+        let mid = (m.vertices[0] + m.vertices[1]) / 2.0;
+        m.vertices.push(mid);
+        let k = (m.vertices.len() - 1) as u32;
+        m.triangles.push([0, 1, k]);
+        assert!(matches!(
+            validate(m).unwrap_err(),
+            MeshError::Degenerate { .. }
+        ));
+    }
+
+    #[test]
+    fn flat_closed_surface_has_no_volume() {
+        // A "solid" folded flat: two triangles back to back.
+        let m = IndexedMesh {
+            vertices: vec![Vector3::zeros(), Vector3::x(), Vector3::y()],
+            triangles: vec![[0, 1, 2], [0, 2, 1]],
+        };
+        assert!(matches!(
+            validate(m).unwrap_err(),
+            MeshError::ZeroVolume { .. }
+        ));
+    }
+}

@@ -1,0 +1,110 @@
+//! The command line: `rodstudy mass`, `rodstudy setup`, exit statuses and messages.
+
+use rodstudy::geometry::primitives::{binary_stl, to_soup, voxel_rod};
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn rodstudy(args: &[&str], envs: &[(&str, &str)]) -> Output {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_rodstudy"));
+    c.args(args);
+    for (k, v) in envs {
+        c.env(k, v);
+    }
+    c.output().unwrap()
+}
+
+fn rod_file(dir: &Path, name: &str) {
+    std::fs::write(
+        dir.join(name),
+        binary_stl(&to_soup(&voxel_rod().0.scaled(1000.0))),
+    )
+    .unwrap();
+}
+
+#[test]
+fn mass_json_reports_good_designs_and_fails_on_bad_ones() {
+    let dir = tempfile::tempdir().unwrap();
+    rod_file(dir.path(), "a_good.stl");
+    std::fs::write(dir.path().join("b_broken.stl"), b"solid broken\nfacet\n").unwrap();
+    let out = rodstudy(&["mass", "--json", dir.path().to_str().unwrap()], &[]);
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "a failed design makes the exit status non-zero"
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let designs = json.as_array().unwrap();
+    assert_eq!(designs.len(), 1);
+    let d = &designs[0];
+    for field in [
+        "design",
+        "file",
+        "volume_m3",
+        "mass_kg",
+        "centroid_m",
+        "inertia_about_centroid_kgm2",
+        "principal_moments_kgm2",
+        "l1_m",
+        "offset_m",
+        "i_zz_kgm2",
+        "i_xx_kgm2",
+    ] {
+        assert!(d.get(field).is_some(), "missing field {field}");
+    }
+    assert_eq!(
+        d["inertia_about_centroid_kgm2"].as_array().unwrap().len(),
+        3
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("b_broken.stl") && stderr.contains("ASCII STL"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn mass_table_for_people_and_success_status() {
+    let dir = tempfile::tempdir().unwrap();
+    rod_file(dir.path(), "rod.stl");
+    let out = rodstudy(&["mass", dir.path().join("rod.stl").to_str().unwrap()], &[]);
+    assert_eq!(out.status.code(), Some(0));
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        table.contains("| rod |") && table.contains("I_zz pin axis"),
+        "{table}"
+    );
+}
+
+#[test]
+fn missing_paths_and_interpreters_are_clear_errors() {
+    let out = rodstudy(&["mass", "/no/such/place.stl"], &[]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no such file or folder"));
+
+    let out = rodstudy(&["setup"], &[("RODSTUDY_PYTHON", "/no/such/python3")]);
+    assert_eq!(out.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        e.contains("RODSTUDY_PYTHON=/no/such/python3 cannot be used"),
+        "{e}"
+    );
+
+    // A fresh project root on a machine without python3 on the PATH.
+    let root = tempfile::tempdir().unwrap();
+    std::fs::create_dir(root.path().join("pipeline")).unwrap();
+    std::fs::write(root.path().join("pipeline/requirements.txt"), "numpy\n").unwrap();
+    let empty_path = tempfile::tempdir().unwrap();
+    let out = rodstudy(
+        &["setup"],
+        &[
+            ("RODSTUDY_ROOT", root.path().to_str().unwrap()),
+            ("PATH", empty_path.path().to_str().unwrap()),
+        ],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        e.contains("python3") && e.contains("not found on the PATH"),
+        "{e}"
+    );
+}
