@@ -34,7 +34,8 @@ impl MechanismFrame {
         let ab = piston_pin - crank_pin;
         let in_plane = ab - z * z.dot(&ab);
         let centre_distance = in_plane.norm();
-        if !(centre_distance > 1e-9 * ab.norm().max(1e-12)) || centre_distance == 0.0 {
+        if centre_distance.is_nan() || centre_distance <= 1e-9 * ab.norm() || centre_distance == 0.0
+        {
             bail!(
                 "the crank and piston pins coincide in the plane of motion (A→B = {ab:?} m is parallel to the pin axis)"
             );

@@ -35,7 +35,7 @@ pub fn validate(mut mesh: IndexedMesh) -> Result<ValidMesh, MeshError> {
     let volume = signed_volume(&mesh);
     let (lo, hi) = mesh.bounding_box();
     let box_volume: f64 = (0..3).map(|k| hi[k] - lo[k]).product();
-    if !(volume.abs() > 1e-12 * box_volume) {
+    if volume.is_nan() || volume.abs() <= 1e-12 * box_volume {
         return Err(MeshError::ZeroVolume { volume });
     }
     if volume < 0.0 {
