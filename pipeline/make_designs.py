@@ -104,9 +104,9 @@ MESH_OPTIONS = {
     "General.NumThreads": 1,
     "Geometry.OCCParallel": 0,
     "Mesh.Algorithm": 6,  # Frontal-Delaunay for surfaces
-    "Mesh.MeshSizeFromCurvature": 240,  # elements per 2*pi of curvature
-    "Mesh.MeshSizeMin": 0.4,
-    "Mesh.MeshSizeMax": 3.0,
+    "Mesh.MeshSizeFromCurvature": 150,  # elements per 2*pi of curvature (2.4 degrees per chord)
+    "Mesh.MeshSizeMin": 0.8,
+    "Mesh.MeshSizeMax": 6.0,
     "Mesh.MeshSizeExtendFromBoundary": 1,
     "Mesh.MeshSizeFromPoints": 0,
     "Mesh.RandomSeed": 1,
@@ -176,11 +176,11 @@ DESIGNS = {
               {"shank_h": 23.0, "shank_dh": 7.0, "flange": 7.0, "web": 12.0},
               ("boss_half_span", "eye_b_r", "web"), (56.0, 30.5, 12.0)),
     2: Design(2, "Design 2: solid shank (heaviest)", "solid",
-              {"shank_dh": 6.0},
-              ("boss_half_span", "eye_b_r", "shank_h"), (55.0, 27.0, 25.0)),
+              {"shank_dh": 3.0},
+              ("boss_half_span", "eye_b_r", "shank_h"), (55.1, 25.5, 25.3)),
     3: Design(3, "Design 3: I-beam shank, heavier flanges", "ibeam",
-              {"shank_h": 28.0, "shank_dh": 6.0, "flange": 12.0, "web": 20.0},
-              ("boss_half_span", "eye_b_r", "web"), (50.5, 28.7, 20.0)),
+              {"shank_h": 26.0, "shank_dh": 6.0, "flange": 12.0, "web": 20.0},
+              ("boss_half_span", "eye_b_r", "web"), (52.1, 29.5, 21.3)),
     4: Design(4, "Design 4: shank with lightening slot", "slot",
               {"shank_h": 24.0, "shank_dh": 8.0, "flange": 9.5},
               ("boss_half_span", "eye_b_r", "flange"), (53.6, 30.6, 9.5)),
@@ -466,9 +466,12 @@ def validate_mesh(vertices, tris, label: str) -> None:
     problems = []
     if np.any((tris[:, 0] == tris[:, 1]) | (tris[:, 1] == tris[:, 2]) | (tris[:, 2] == tris[:, 0])):
         problems.append("triangle with a repeated vertex")
-    area2 = np.linalg.norm(np.cross(v[tris[:, 1]] - v[tris[:, 0]], v[tris[:, 2]] - v[tris[:, 0]]), axis=1)
-    if np.any(area2 <= 1e-8):
-        problems.append(f"{np.count_nonzero(area2 <= 1e-8)} degenerate triangles (area < 5e-9 mm^2)")
+    p0, p1, p2 = v[tris[:, 0]], v[tris[:, 1]], v[tris[:, 2]]
+    cross = np.linalg.norm(np.cross(p1 - p0, p2 - p0), axis=1)
+    longest2 = np.max([np.sum((p1 - p0) ** 2, 1), np.sum((p2 - p1) ** 2, 1), np.sum((p0 - p2) ** 2, 1)], axis=0)
+    degenerate = cross <= 1e-9 * longest2  # (near-)collinear corners
+    if np.any(degenerate):
+        problems.append(f"{np.count_nonzero(degenerate)} degenerate triangles")
     try:
         _, _, same = edge_pairs(tris)
         if np.any(same):
@@ -553,6 +556,14 @@ def occ_eval(d: Design, x) -> dict:
     return occ_properties(build_rod(d, p))
 
 
+def mismatch(d: Design, x, goal: dict) -> np.ndarray:
+    """Residual at x, or +inf when the trial shape cannot be built as designed."""
+    try:
+        return residual(occ_eval(d, x), goal)
+    except AssertionError:
+        return np.full(3, np.inf)
+
+
 def calibrate(d: Design, goal: dict, x0, fd_step: float = 1e-3, max_iter: int = 40) -> np.ndarray:
     """Newton iteration with a forward-difference Jacobian on the exact OCC properties."""
     x = np.array(x0, dtype=np.float64)
@@ -569,7 +580,7 @@ def calibrate(d: Design, goal: dict, x0, fd_step: float = 1e-3, max_iter: int = 
         step *= min(1.0, 3.0 / np.max(np.abs(step)))  # at most 3 mm per iteration
         lam = 1.0
         while True:  # backtracking: accept only steps that reduce the mismatch
-            r_new = residual(occ_eval(d, x + lam * step), goal)
+            r_new = mismatch(d, x + lam * step, goal)
             if np.linalg.norm(r_new) < np.linalg.norm(r) or lam < 1e-3:
                 break
             lam *= 0.5
@@ -597,26 +608,27 @@ def tessellate(d: Design, x):
     return verts, tris, exact
 
 
-def generate(d: Design, log=print):
+def generate(d: Design):
     """Calibrate design d on the exact B-rep, correct for the tessellation, return final mesh + data."""
     tgt = TABLE_5_1[d.number]
     goal = {"mass": tgt.mass, "ixx": tgt.ixx, "l1": tgt.l1}
     x = round_params(calibrate(d, goal, d.start))
-    for attempt in range(3):
-        verts, tris, exact = tessellate(d, x)
-        stl = mesh_mass_properties(verts, tris)
-        err = errors(stl, tgt)
-        if within(err, TOL_AIM) and abs(err["mass_rel"]) < 2e-5 and abs(err["l1_mm"]) < 2e-3 \
-                and abs(err["ixx_rel"]) < 2e-5:
-            break
-        # Shift the exact-geometry goal by the tessellation's (smooth, nearly constant) bias.
+    verts, tris, exact = tessellate(d, x)
+    stl = mesh_mass_properties(verts, tris)
+    for _ in range(3):
+        # Shift the exact-geometry goal by the tessellation's (small, nearly constant) bias and
+        # solve again, so that the STL -- not the B-rep -- carries the Table 5.1 values.
         goal = {"mass": goal["mass"] * exact["mass"] / stl["mass"],
                 "ixx": goal["ixx"] * exact["ixx"] / stl["ixx"],
                 "l1": goal["l1"] + exact["l1"] - stl["l1"]}
-        log(f"  design {d.number}: tessellation correction pass {attempt + 1} "
-            f"(STL-vs-exact mass {stl['mass'] / exact['mass'] - 1:+.2e}, "
-            f"I_xx {stl['ixx'] / exact['ixx'] - 1:+.2e}, l1 {stl['l1'] - exact['l1']:+.4f} mm)")
         x = round_params(calibrate(d, goal, x))
+        verts, tris, exact = tessellate(d, x)
+        stl = mesh_mass_properties(verts, tris)
+        err = errors(stl, tgt)
+        if abs(err["mass_rel"]) < 1e-5 and abs(err["ixx_rel"]) < 1e-5 and abs(err["l1_mm"]) < 1e-3:
+            break
+    err = errors(stl, tgt)
+    assert within(err, TOL_AIM), f"design {d.number}: STL misses the aimed tolerance: {err}"
     chord = stl["mass"] / exact["mass"] - 1.0
     assert abs(chord) <= CHORD_MASS_REL_MAX, f"design {d.number}: tessellation moves mass by {chord:.2e}"
     return {"design": d, "x": x, "params": d.params(x), "verts": verts, "tris": tris,
@@ -646,7 +658,8 @@ def peak_pin_force(m3: float, l1_m: float) -> float:
 def beam_bending_stress(d: Design, p: dict, force: float) -> float:
     """Nominal bending stress [MPa] of the shank section where it meets the small-end eye, for an
     in-plane transverse force at A with B fixed (SPEC Stage 3 F_y case): sigma = F x / Z. A ranking
-    aid only; for the slot the two rails are taken as one section (the FEM will be higher)."""
+    aid only. For the slot, the rails also bend locally over the slot length (Vierendeel action:
+    each rail carries half the shear, inflection point at mid-slot), which is added."""
     x = CENTRE_DISTANCE - p["eye_b_r"] - p["pocket_gap"]
     h, t = shank_half_width(p, x), p["shank_t"]
     full = t * (2 * h) ** 3 / 12.0
@@ -656,7 +669,11 @@ def beam_bending_stress(d: Design, p: dict, force: float) -> float:
         second = full - t * (2 * h - 2 * p["flange"]) ** 3 / 12.0
     else:
         second = full
-    return force * x / (second / h)
+    sigma = force * x / (second / h)
+    if d.kind == "slot":
+        slot_len = x - (p["eye_a_r"] + p["pocket_gap"])
+        sigma += (force / 2) * (slot_len / 2) / (t * p["flange"] ** 2 / 6.0)
+    return sigma
 
 
 # ---------------------------------------------------------------------------------------------
@@ -867,12 +884,35 @@ def selftest() -> int:
         expect(path.stat().st_size == 84 + 50 * len(tris) and not path.read_bytes().startswith(b"solid"),
                "binary STL size and header")
     p = mesh_mass_properties(v2, t2)
-    expect(abs(p["mass"] / exact["mass"] - 1) < CHORD_MASS_REL_MAX,
-           f"tessellated ring mass vs exact: {p['mass'] / exact['mass'] - 1:+.2e}")
+    # A ring has no concave/convex cancellation: its section is exact * sin(t)/t for chords of angle
+    # t = 2 pi / N (both circles inscribed), so the tessellation loses about t^2/6 of the mass.
+    theta = 2 * math.pi / MESH_OPTIONS["Mesh.MeshSizeFromCurvature"]
+    rel = p["mass"] / exact["mass"] - 1
+    expect(-1.05 * theta**2 / 6 <= rel <= 0,
+           f"tessellated ring mass vs exact {rel:+.2e} (inscribed-polygon bound {-theta**2 / 6:+.2e})")
     expect(abs(p["ixx"] / exact["ixx"] - 1) < 1e-3 and abs(p["izz"] / exact["izz"] - 1) < 1e-3,
            "tessellated ring inertia vs exact")
     expect(pin_axes_clear(v2, t2, [(0.0, 0.0)]) == [] and pin_axes_clear(v2, t2, [(35.0, 0.0)]) != [],
            "pin-axis ray test (clear in the bore, hits in the wall)")
+
+    # 5. A polyhedral (faceted, hence exactly tessellated) OCC solid: mesh integration == OCC.
+    gmsh.clear()
+    body = occ.addBox(-40, -15, -10, 90, 30, 20)
+    wedge = occ_prism([(20, -20), (60, -20), (60, 5)], -20, 40)
+    notch = occ.addBox(-50, 5, 0, 30, 20, 20)
+    out, _ = occ.cut([(3, body)], [(3, wedge), (3, notch)])
+    occ.rotate(out, 0, 0, 0, 1, 2, 3, 0.7)
+    occ.translate(out, 180, -30, 12)
+    occ.synchronize()
+    exact = occ_properties(out[0][1])
+    verts, tris = surface_triangles()
+    tris = orient_outward(tris, verts)
+    validate_mesh(verts, tris, "polyhedron")
+    p = mesh_mass_properties(verts, tris)
+    expect(abs(p["mass"] / exact["mass"] - 1) < 1e-6
+           and np.allclose(p["centroid"], exact["centroid"], rtol=0, atol=1e-5)
+           and np.allclose(p["inertia"], exact["inertia"], rtol=0, atol=1e-6 * np.abs(exact["inertia"]).max()),
+           "rotated polyhedron: mesh integration (float32 vertices) matches OCC's exact tensor")
     print("selftest " + ("passed" if not failures else f"FAILED ({len(failures)})"))
     return 0 if not failures else 1
 

@@ -4,6 +4,8 @@
 //!
 //! - [`geometry`]: stage 1, reading STL, validating the solid, exact mass properties and the
 //!   mapping into the mechanism frame;
+//! - [`mechanism`]: stage 2, the planar crank–slider: closed-form Newton–Euler and a planar
+//!   multibody core (thesis §3.2), the driven scene and its peak pin force;
 //! - [`study`]: running the stages over every design of a folder;
 //! - [`python_env`]: the project-local Python environment the `pipeline/` scripts run in;
 //! - [`bench`]: benchmarks, reported as ratios against a reference run;
@@ -12,5 +14,6 @@
 pub mod bench;
 pub mod cli;
 pub mod geometry;
+pub mod mechanism;
 pub mod python_env;
 pub mod study;

@@ -1,8 +1,12 @@
 //! `rodstudy bench mass [--triangles N] [--repeats R] [--json]`
 
 use crate::bench::mass::bench_mass;
+use crate::geometry::design::mass_of_design;
+use crate::mechanism::{DrivenScene, MechanismParams, RodInertia, bench_driven};
+use crate::study::dynamics_stage::{mechanism_for, rod_inertia};
 use anyhow::Result;
 use clap::Subcommand;
+use std::path::PathBuf;
 
 #[derive(Subcommand)]
 pub enum BenchCommand {
@@ -13,6 +17,17 @@ pub enum BenchCommand {
         triangles: usize,
         /// Repeats per step; the median is reported.
         #[arg(long, default_value_t = 5)]
+        repeats: usize,
+        #[arg(long)]
+        json: bool,
+    },
+    /// Stage 2: the full driven scene (5000 steps) through the multibody core against the
+    /// closed form, for one design (default: the thesis' original rod, ch. 3 data).
+    Dynamics {
+        /// An STL design whose rod is used instead of the thesis' original rod.
+        design: Option<PathBuf>,
+        /// Repeats per method; the median is reported.
+        #[arg(long, default_value_t = 11)]
         repeats: usize,
         #[arg(long)]
         json: bool,
@@ -50,6 +65,57 @@ pub fn run(command: BenchCommand) -> Result<i32> {
             println!(
                 "\nvolume vs the smooth torus: {:.2e} relative (tessellation error, O(1/n²))",
                 b.volume_rel_error_vs_smooth_torus
+            );
+            Ok(0)
+        }
+        BenchCommand::Dynamics {
+            design,
+            repeats,
+            json,
+        } => {
+            let (name, params, rod) = match &design {
+                Some(path) => {
+                    let m = mass_of_design(path)?;
+                    (m.design.clone(), mechanism_for(&m, true), rod_inertia(&m))
+                }
+                None => (
+                    "thesis original rod (ch. 3)".to_string(),
+                    MechanismParams::default(),
+                    RodInertia::thesis_original(),
+                ),
+            };
+            let scene = DrivenScene::default();
+            let b = bench_driven(&params, &rod, &scene, repeats)?;
+            if json {
+                println!("{}", serde_json::to_string_pretty(&b)?);
+                return Ok(0);
+            }
+            println!(
+                "driven scene ({} steps, {} samples) for {name}, median of {} runs:\n",
+                b.steps, b.samples, b.repeats
+            );
+            println!(
+                "| model | per scene [ms] | per step [µs] | × closed form |\n|---|---|---|---|"
+            );
+            println!(
+                "| closed-form Newton–Euler | {:.3} | {:.3} | 1.0 |",
+                b.closed_form_scene_s * 1e3,
+                b.closed_form_per_step_s * 1e6
+            );
+            println!(
+                "| multibody core (9 coordinates, Newton–Raphson, multipliers) | {:.3} | {:.3} | {:.1} |",
+                b.multibody_scene_s * 1e3,
+                b.multibody_per_step_s * 1e6,
+                b.ratio_multibody_over_closed_form
+            );
+            println!(
+                "| refined peak only (closed form, one revolution) | {:.4} | — | {:.3} |",
+                b.peak_only_s * 1e3,
+                b.peak_only_s / b.closed_form_scene_s
+            );
+            println!(
+                "\npeak {:.3} N; multibody vs closed form: max relative difference {:.2e}",
+                b.peak_pin_force_n, b.max_rel_diff
             );
             Ok(0)
         }

@@ -4,6 +4,7 @@
 //! are still reported), 2 for a usage error or a failure that stops the whole command.
 
 mod bench;
+mod dynamics;
 mod mass;
 mod pipeline;
 mod study;
@@ -26,6 +27,9 @@ enum Command {
     /// Mass properties of STL designs (files or folders): volume, mass, centroid, inertia,
     /// principal axes, and l1, offset, I_zz, I_xx in the mechanism frame.
     Mass(mass::MassArgs),
+    /// Stage 2: the crank–slider with each design's rod (peak crank–rod pin force).
+    #[command(subcommand)]
+    Dynamics(dynamics::DynamicsCommand),
     /// Run every stage that exists on every design of a folder and write the reports.
     Study(study::StudyArgs),
     /// Benchmarks, reported as ratios against a reference run in the same process.
@@ -48,6 +52,7 @@ pub fn main() -> i32 {
     };
     let result = match cli.command {
         Command::Mass(args) => mass::run(args),
+        Command::Dynamics(command) => dynamics::run(command),
         Command::Study(args) => study::run(args),
         Command::Bench(command) => bench::run(command),
         Command::Setup => pipeline::setup(),

@@ -1,6 +1,7 @@
 //! `rodstudy study [--designs DIR] [--out DIR]`
 
-use crate::study::{run_study, tables::mass_table, write_reports};
+use crate::study::tables::{dynamics_table, mass_table};
+use crate::study::{run_study, write_reports};
 use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
@@ -26,13 +27,16 @@ pub fn run(args: StudyArgs) -> Result<i32> {
     );
     let designs: Vec<_> = results.designs.iter().map(|d| &d.mass).collect();
     print!("{}", mass_table(&designs));
+    let dynamics: Vec<_> = results.designs.iter().map(|d| &d.dynamics).collect();
+    println!();
+    print!("{}", dynamics_table(&dynamics));
     for d in &designs {
         for w in &d.warnings {
             eprintln!("warning: {}: {w}", d.file);
         }
     }
     for f in &results.failed {
-        eprintln!("FAILED {}: {}", f.file, f.error);
+        eprintln!("FAILED {}", f.error);
     }
     let written = write_reports(&results, &args.out)?;
     for path in written {

@@ -1,22 +1,26 @@
 //! The study: every stage that exists, run on every design of a folder, and the reports.
 //!
-//! Today the stages are: 1 mass properties (always). One broken design never stops the others:
+//! Today the stages are: 1 mass properties, 2 the driven crank–slider (peak pin force, closed
+//! form; no time integration, the mechanism has zero DOF). One broken design never stops the others:
 //! it is listed in the report with its error, and the command's exit status says so.
 
 pub mod atomic_write;
+pub mod dynamics_stage;
 pub mod tables;
 
 use crate::geometry::design::{DesignMass, find_stl_files, mass_of_design};
+use crate::mechanism::{DrivenResult, DrivenScene, Method};
 use anyhow::{Result, bail};
 use atomic_write::write_atomic;
+use dynamics_stage::{DesignDynamics, dynamics_of_design, write_history_csv};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
 /// The stages this version runs, in order, for the report's `stages_run`.
-pub const STAGES_RUN: &[&str] = &["mass"];
+pub const STAGES_RUN: &[&str] = &["mass", "dynamics driven"];
 /// Stages of the specification not built yet, so the report says what it did not do.
-pub const STAGES_NOT_YET_AVAILABLE: &[&str] = &["dynamics", "fem"];
+pub const STAGES_NOT_YET_AVAILABLE: &[&str] = &["fem"];
 
 /// Everything the study found, as written to `results.json`.
 #[derive(Debug, Clone, Serialize)]
@@ -32,6 +36,10 @@ pub struct StudyResults {
 #[derive(Debug, Clone, Serialize)]
 pub struct DesignResult {
     pub mass: DesignMass,
+    pub dynamics: DesignDynamics,
+    /// The pin-force history (written to its own CSV, not to `results.json`).
+    #[serde(skip)]
+    pub history: DrivenResult,
 }
 
 /// A design that could not be studied, and why.
@@ -50,7 +58,7 @@ pub fn run_study(designs: &Path) -> Result<StudyResults> {
     let outcomes: Vec<(PathBuf, Result<DesignResult>)> = files
         .into_par_iter()
         .map(|f| {
-            let r = mass_of_design(&f).map(|mass| DesignResult { mass });
+            let r = study_one(&f);
             (f, r)
         })
         .collect();
@@ -76,6 +84,19 @@ pub fn run_study(designs: &Path) -> Result<StudyResults> {
     Ok(results)
 }
 
+/// Stage 1 then stage 2 for one design, with the spec's scene (φ = 40πt, 5 s, 5000 steps,
+/// gravity on).
+fn study_one(stl: &Path) -> Result<DesignResult> {
+    let mass = mass_of_design(stl)?;
+    let (dynamics, history) =
+        dynamics_of_design(&mass, &DrivenScene::default(), true, Method::ClosedForm)?;
+    Ok(DesignResult {
+        mass,
+        dynamics,
+        history,
+    })
+}
+
 /// Writes `results.json`, `mass_properties.md` and `mass_properties.csv` into `out`
 /// (each atomically) and returns their paths.
 pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>> {
@@ -85,7 +106,64 @@ pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>>
     write_atomic(&md, markdown(results).as_bytes())?;
     let csv_path = out.join("mass_properties.csv");
     write_atomic(&csv_path, &csv_table(results)?)?;
-    Ok(vec![json, md, csv_path])
+    let ranking = out.join("ranking.md");
+    write_atomic(&ranking, ranking_markdown(results).as_bytes())?;
+    let mut written = vec![json, md, csv_path, ranking];
+    for d in &results.designs {
+        let mut w = csv::Writer::from_writer(Vec::new());
+        write_history_csv(&mut w, &d.mass.design, &d.history)?;
+        let path = out.join(file_safe(&d.mass.design)).join("pin_force.csv");
+        write_atomic(&path, &w.into_inner()?)?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+/// A design name usable as a folder name.
+fn file_safe(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
+/// The ranking so far: by peak pin force, lowest first (the stress criterion joins it with the
+/// FEM stage).
+fn ranking_markdown(results: &StudyResults) -> String {
+    let mut ranked: Vec<&DesignResult> = results.designs.iter().collect();
+    ranked.sort_by(|a, b| {
+        a.dynamics
+            .peak_pin_force_n
+            .total_cmp(&b.dynamics.peak_pin_force_n)
+    });
+    let mut out = String::from(
+        "# Ranking of the designs\n\nRanked by the peak crank–rod pin force of the driven crank–slider (φ = 40πt, gravity on), lowest first. The stress criterion (FEM stage) is not available yet, so no design is judged on stress.\n\n| rank | design | mass [kg] | l1 [mm] | I_zz [kg·m²] | I_xx [kg·m²] | peak pin force [N] | at crank angle [°] |\n|---|---|---|---|---|---|---|---|\n",
+    );
+    for (k, d) in ranked.iter().enumerate() {
+        out.push_str(&format!(
+            "| {} | {} | {:.4} | {:.2} | {:.5} | {:.6} | {:.1} | {:.2} |\n",
+            k + 1,
+            d.mass.design,
+            d.mass.mass_kg,
+            d.mass.l1_m * 1e3,
+            d.mass.i_zz_kgm2,
+            d.mass.i_xx_kgm2,
+            d.dynamics.peak_pin_force_n,
+            d.dynamics.peak_crank_angle_deg
+        ));
+    }
+    if !results.failed.is_empty() {
+        out.push_str("\n## Failed designs\n\n");
+        for f in &results.failed {
+            out.push_str(&format!("- `{}`: {}\n", f.file, f.error));
+        }
+    }
+    out
 }
 
 fn markdown(results: &StudyResults) -> String {
@@ -105,47 +183,53 @@ fn markdown(results: &StudyResults) -> String {
     out
 }
 
+/// One row of `mass_properties.csv` (SI units; empty figures for a failed design).
+#[derive(Serialize, Default)]
+struct CsvRow {
+    design: String,
+    file: String,
+    mass_kg: Option<f64>,
+    volume_m3: Option<f64>,
+    l1_m: Option<f64>,
+    offset_m: Option<f64>,
+    i_zz_kgm2: Option<f64>,
+    i_xx_kgm2: Option<f64>,
+    centroid_x_m: Option<f64>,
+    centroid_y_m: Option<f64>,
+    centroid_z_m: Option<f64>,
+    peak_pin_force_n: Option<f64>,
+    status: &'static str,
+    error: String,
+}
+
 fn csv_table(results: &StudyResults) -> Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record([
-        "design",
-        "file",
-        "mass_kg",
-        "volume_m3",
-        "l1_m",
-        "offset_m",
-        "i_zz_kgm2",
-        "i_xx_kgm2",
-        "centroid_x_m",
-        "centroid_y_m",
-        "centroid_z_m",
-        "status",
-        "error",
-    ])?;
     for d in &results.designs {
         let m = &d.mass;
-        let num = |x: f64| format!("{x:.12e}");
-        w.write_record([
-            m.design.clone(),
-            m.file.clone(),
-            num(m.mass_kg),
-            num(m.volume_m3),
-            num(m.l1_m),
-            num(m.offset_m),
-            num(m.i_zz_kgm2),
-            num(m.i_xx_kgm2),
-            num(m.centroid_m[0]),
-            num(m.centroid_m[1]),
-            num(m.centroid_m[2]),
-            "ok".into(),
-            String::new(),
-        ])?;
+        w.serialize(CsvRow {
+            design: m.design.clone(),
+            file: m.file.clone(),
+            mass_kg: Some(m.mass_kg),
+            volume_m3: Some(m.volume_m3),
+            l1_m: Some(m.l1_m),
+            offset_m: Some(m.offset_m),
+            i_zz_kgm2: Some(m.i_zz_kgm2),
+            i_xx_kgm2: Some(m.i_xx_kgm2),
+            centroid_x_m: Some(m.centroid_m[0]),
+            centroid_y_m: Some(m.centroid_m[1]),
+            centroid_z_m: Some(m.centroid_m[2]),
+            peak_pin_force_n: Some(d.dynamics.peak_pin_force_n),
+            status: "ok",
+            error: String::new(),
+        })?;
     }
     for f in &results.failed {
-        let mut row = vec![String::new(), f.file.clone()];
-        row.extend(std::iter::repeat_n(String::new(), 9));
-        row.extend(["failed".into(), f.error.clone()]);
-        w.write_record(row)?;
+        w.serialize(CsvRow {
+            file: f.file.clone(),
+            status: "failed",
+            error: f.error.clone(),
+            ..CsvRow::default()
+        })?;
     }
     Ok(w.into_inner()?)
 }

@@ -24,3 +24,26 @@ pub fn mass_table(designs: &[&DesignMass]) -> String {
     }
     out
 }
+
+/// The stage-2 table for people: the peak crank–rod pin force of each design.
+pub fn dynamics_table(designs: &[&crate::study::dynamics_stage::DesignDynamics]) -> String {
+    let mut out = String::from(
+        "| design | peak pin force [N] | at crank angle [°] | at t [s] | TDC formula [N] | ∂F/∂m3 [N/kg] | ∂F/∂l1 [N/mm] | ∂F/∂I_zz [N/(kg·m²)] | gravity |\n|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for d in designs {
+        let s = &d.sensitivity;
+        out.push_str(&format!(
+            "| {} | {:.2} | {:.3} | {:.5} | {:.2} | {:.2} | {:.3} | {:.2e} | {} |\n",
+            d.design,
+            d.peak_pin_force_n,
+            d.peak_crank_angle_deg,
+            d.peak_time_s,
+            d.tdc_formula_n,
+            s.d_mass_n_per_kg,
+            s.d_l1_n_per_m * 1e-3,
+            s.d_izz_n_per_kgm2,
+            if d.gravity { "on" } else { "off" }
+        ));
+    }
+    out
+}

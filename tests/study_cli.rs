@@ -1,0 +1,145 @@
+//! `rodstudy study` and `rodstudy dynamics driven` end to end on generated designs: the reports,
+//! one broken design not stopping the others, and the peak force against the closed form.
+
+use rodstudy::geometry::primitives::{binary_stl, to_soup, voxel_rod};
+use rodstudy::mechanism::{MechanismParams, RodInertia, tdc_peak_formula};
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn rodstudy(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_rodstudy"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn rod_file(dir: &Path, name: &str) {
+    std::fs::write(
+        dir.join(name),
+        binary_stl(&to_soup(&voxel_rod().0.scaled(1000.0))),
+    )
+    .unwrap();
+}
+
+#[test]
+fn study_writes_reports_and_lists_the_broken_design() {
+    let designs = tempfile::tempdir().unwrap();
+    let out = tempfile::tempdir().unwrap();
+    rod_file(designs.path(), "good.stl");
+    let mut open = to_soup(&voxel_rod().0.scaled(1000.0));
+    open.pop();
+    std::fs::write(designs.path().join("holed.stl"), binary_stl(&open)).unwrap();
+    let o = rodstudy(&[
+        "study",
+        "--designs",
+        designs.path().to_str().unwrap(),
+        "--out",
+        out.path().to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "a failed design gives exit status 1: {stderr}"
+    );
+    assert!(
+        stderr.contains("ran mass, dynamics driven") && stderr.contains("not yet available: fem"),
+        "{stderr}"
+    );
+    let results: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.path().join("results.json")).unwrap()).unwrap();
+    assert_eq!(results["designs"].as_array().unwrap().len(), 1);
+    let failed = &results["failed"][0];
+    assert!(failed["file"].as_str().unwrap().ends_with("holed.stl"));
+    assert!(failed["error"].as_str().unwrap().contains("open mesh"));
+    let d = &results["designs"][0];
+    // The peak at top dead centre follows from mass and l1 alone (gravity adds ~0.02 N).
+    let rod = RodInertia::new(
+        d["mass"]["mass_kg"].as_f64().unwrap(),
+        d["mass"]["l1_m"].as_f64().unwrap(),
+        0.02,
+    );
+    let formula = tdc_peak_formula(
+        &MechanismParams::default(),
+        &rod,
+        40.0 * std::f64::consts::PI,
+    );
+    let peak = d["dynamics"]["peak_pin_force_n"].as_f64().unwrap();
+    assert!((peak - formula).abs() < 0.1, "{peak} vs {formula}");
+    let ranking = std::fs::read_to_string(out.path().join("ranking.md")).unwrap();
+    assert!(
+        ranking.contains("| 1 | good |") && ranking.contains("holed.stl"),
+        "{ranking}"
+    );
+    let history = std::fs::read_to_string(out.path().join("good").join("pin_force.csv")).unwrap();
+    assert_eq!(history.lines().count(), 5002, "header + 5001 samples");
+    for entry in std::fs::read_dir(out.path()).unwrap() {
+        let name = entry.unwrap().file_name().to_string_lossy().into_owned();
+        assert!(
+            !name.starts_with(".tmp"),
+            "temporary file left behind: {name}"
+        );
+    }
+}
+
+#[test]
+fn empty_designs_folder_is_a_clear_error() {
+    let designs = tempfile::tempdir().unwrap();
+    let out = tempfile::tempdir().unwrap();
+    let o = rodstudy(&[
+        "study",
+        "--designs",
+        designs.path().to_str().unwrap(),
+        "--out",
+        out.path().to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no .stl files"));
+    assert!(
+        std::fs::read_dir(out.path()).unwrap().next().is_none(),
+        "nothing written"
+    );
+}
+
+#[test]
+fn dynamics_driven_json_and_csv() {
+    let dir = tempfile::tempdir().unwrap();
+    rod_file(dir.path(), "rod.stl");
+    let csv = dir.path().join("history.csv");
+    let o = rodstudy(&[
+        "dynamics",
+        "driven",
+        dir.path().join("rod.stl").to_str().unwrap(),
+        "--json",
+        "--csv",
+        csv.to_str().unwrap(),
+        "--method",
+        "multibody",
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let d = &json[0];
+    for field in [
+        "design",
+        "peak_pin_force_n",
+        "peak_crank_angle_deg",
+        "peak_time_s",
+        "gravity",
+    ] {
+        assert!(d.get(field).is_some(), "missing {field}");
+    }
+    assert_eq!(d["method"], "multibody");
+    assert_eq!(d["gravity"], true);
+    let angle = d["peak_crank_angle_deg"].as_f64().unwrap();
+    assert!(
+        !(0.1..=359.9).contains(&angle),
+        "peak at top dead centre, got {angle}°"
+    );
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert!(text.starts_with("design,t_s,phi_rad,fa_x_n,fa_y_n,fa_abs_n"));
+}
