@@ -20,7 +20,7 @@
 //! | `revolute.rs` | revolute joint, eq. 2.17–2.19 |
 //! | `translational.rs` | translational joint, eq. 2.28–2.29 |
 //! | `driving.rs` | driving constraint φⱼ − φᵢ = f(t) |
-//! | `lu.rs` | fixed-size LU factorisations (partial and rank-revealing complete pivoting), rank diagnosis |
+//! | `lu.rs` | nalgebra's fixed-size LU (partial) and `FullPivLU` (rank-revealing) behind one interface, plus what nalgebra lacks: relative pivot, transposed solve, dependent-row diagnosis |
 //! | `system.rs` | [`MultibodySystem`]: assembly of Φ, D, γ, M, h; Newton–Raphson position analysis, velocity, acceleration, Lagrange multipliers, joint reactions; [`Tracker`] along the motion |
 //! | `crank_slider.rs` | [`RodInertia`], [`MechanismParams`] (spec defaults, builder, validation), [`CrankSlider`] (validated model, its multibody form), [`PinLoads`] |
 //! | `closed_form.rs` | closed-form kinematics (eq. 2.1–2.12) and hand-solved Newton–Euler loads: the oracle |

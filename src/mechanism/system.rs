@@ -31,10 +31,11 @@
 //! S = R D C with R = diag(1 or L) (angle rows times the characteristic length
 //! L) and C = diag(1, 1, 1/L, …), so that entries are O(1) and the relative
 //! pivot min|u_kk|/max|u_kk| of an LU is a meaningful rank test. Every
-//! factorisation (each Newton iterate and the converged position) is a
-//! partial-pivoting LU; when its relative pivot falls below [`RANK_CONFIRM`]
-//! (1e-3; healthy crank–slider Jacobians show 0.2–0.7) the rank-revealing
-//! complete-pivoting LU decides and is used instead. A relative pivot of the
+//! factorisation (each Newton iterate and the converged position) is
+//! nalgebra's partial-pivoting LU; when its relative pivot falls below
+//! [`RANK_CONFIRM`] (1e-3; healthy crank–slider Jacobians show 0.3–1) the
+//! rank-revealing complete-pivoting LU (nalgebra's `FullPivLU`) decides and is
+//! used instead (see [`lu`](super::lu)). A relative pivot of the
 //! latter below [`SolverOptions::pivot_threshold`] (1e-8) is reported as
 //! [`DynamicsError::SingularJacobian`] with the time and the joint whose
 //! equation is linearly dependent on the preceding ones (Gram–Schmidt over the
@@ -50,13 +51,13 @@
 //! `SMatrix<f64, N, N>`, arrays); the joint and body lists are built once; the
 //! per-step path allocates nothing (only error messages do).
 
-use nalgebra::{DMatrix, SMatrix, SVector, Vector2};
+use nalgebra::{Const, DMatrix, DimMin, SMatrix, SVector, Vector2};
 
 use super::body::{Body, BodyId, Pose, Twist, cross};
 use super::constraint::{ConstraintEquations, Joint};
 use super::driving::Driving;
 use super::error::{DynamicsError, Result, non_negative, positive};
-use super::lu::{Factorization, FullPivLu, PartialPivLu, most_dependent_row};
+use super::lu::{Factorization, most_dependent_row};
 use super::motion::CrankMotion;
 use super::revolute::Revolute;
 use super::translational::Translational;
@@ -93,7 +94,7 @@ impl Default for SolverOptions {
 
 /// Relative pivot of the partial-pivoting LU below which the rank decision is
 /// handed to the complete-pivoting LU. Healthy crank–slider Jacobians have
-/// ratios of 0.2–0.7 (0.03 at l/r = 1.001), so the costlier factorisation
+/// ratios of 0.3–1 (0.04 at l/r = 1.001), so the costlier factorisation
 /// only runs close to a singular configuration.
 pub const RANK_CONFIRM: f64 = 1e-3;
 
@@ -497,7 +498,10 @@ fn twist_of<const N: usize>(v: &Twists<N>, id: BodyId) -> Twist {
     }
 }
 
-impl<const N: usize> MultibodySystem<N> {
+impl<const N: usize> MultibodySystem<N>
+where
+    Const<N>: DimMin<Const<N>, Output = Const<N>>,
+{
     /// The bodies.
     pub fn bodies(&self) -> &[Body] {
         &self.bodies
@@ -709,26 +713,27 @@ impl<const N: usize> MultibodySystem<N> {
     /// [`RANK_CONFIRM`] of singular, complete pivoting (rank-revealing) decides
     /// and is used instead.
     fn factor(&self, s: &SMatrix<f64, N, N>, t: f64) -> Result<Factorization<N>> {
-        let partial = PartialPivLu::new(*s);
+        let partial = Factorization::Partial(s.lu());
         if partial.pivot_ratio() >= RANK_CONFIRM.max(self.options.pivot_threshold) {
-            return Ok(Factorization::Partial(partial));
+            return Ok(partial);
         }
-        let full = FullPivLu::new(*s);
-        if full.pivot_ratio() < self.options.pivot_threshold {
-            return Err(self.singular_error(s, full.pivot_ratio(), t));
+        let full = Factorization::Full(s.full_piv_lu());
+        let ratio = full.pivot_ratio();
+        if ratio < self.options.pivot_threshold {
+            return Err(self.singular_error(s, ratio, t));
         }
-        Ok(Factorization::Full(full))
+        Ok(full)
     }
 
     /// Rank diagnosis of D at a configuration: `Err(SingularJacobian)` naming
     /// the dependent joint, or the relative pivot.
     pub fn check_jacobian(&self, q: &SVector<f64, N>, t: f64) -> Result<f64> {
         let s = self.assemble_jacobian(&self.poses(q), t, true);
-        let full = FullPivLu::new(s);
-        if full.pivot_ratio() < self.options.pivot_threshold {
-            return Err(self.singular_error(&s, full.pivot_ratio(), t));
+        let ratio = Factorization::Full(s.full_piv_lu()).pivot_ratio();
+        if ratio < self.options.pivot_threshold {
+            return Err(self.singular_error(&s, ratio, t));
         }
-        Ok(full.pivot_ratio())
+        Ok(ratio)
     }
 
     /// Newton–Raphson on Φ(c, t) = 0 from `guess`; returns the converged
@@ -921,7 +926,10 @@ fn predict<const N: usize>(
     taylor + b3 * (x * x * x) + b4 * (x * x * x * x) + b5 * (x * x * x * x * x)
 }
 
-impl<const N: usize> Tracker<'_, N> {
+impl<const N: usize> Tracker<'_, N>
+where
+    Const<N>: DimMin<Const<N>, Output = Const<N>>,
+{
     /// The last solution.
     pub fn last(&self) -> Option<&KinematicSolution<N>> {
         self.last.as_ref()
