@@ -31,7 +31,10 @@ pub struct LoadedDesign {
 /// The mass-stage record of one design, as written to JSON (SI units; see README "mass").
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DesignMass {
+    /// Display name: the sidecar's `name`, else the file stem.
     pub design: String,
+    /// The file stem: a stable identifier, used for per-design report folders.
+    pub id: String,
     pub file: String,
     pub format: String,
     pub triangles: usize,
@@ -127,6 +130,10 @@ pub fn mass_of_design(stl: &Path) -> Result<DesignMass> {
     let m = &d.mass;
     Ok(DesignMass {
         design: d.name,
+        id: stl
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default(),
         file: stl.display().to_string(),
         format: format!("{:?}", d.format).to_lowercase(),
         triangles: d.mesh.triangles.len(),

@@ -112,7 +112,7 @@ pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>>
     for d in &results.designs {
         let mut w = csv::Writer::from_writer(Vec::new());
         write_history_csv(&mut w, &d.mass.design, &d.history)?;
-        let path = out.join(file_safe(&d.mass.design)).join("pin_force.csv");
+        let path = out.join(file_safe(&d.mass.id)).join("pin_force.csv");
         write_atomic(&path, &w.into_inner()?)?;
         written.push(path);
     }

@@ -1,0 +1,285 @@
+#!/usr/bin/env python3
+"""Volume meshing of a rod STL with quadratic tetrahedra for rodstudy's FEM stage (SPEC Stage 3).
+
+Two commands, both ending with one line of JSON on standard output (progress goes to standard error):
+
+  mesh_rod.py mesh STL OUT_DIR [--size 5] [--curved] [--name NAME]
+      STL as a CAD export comes (millimetres, triangle soup) -> gmsh: merge, classify the surface
+      triangles into patches (`classifySurfaces`, angles in radians), `createGeometry` (reparametrised
+      discrete surfaces), surface loop, volume, 3D mesh at the target size, second order (10-node
+      tetrahedra), optimisation. Deterministic: fixed options, one thread, fixed 3D algorithm and
+      random seed, so the same STL and size give the same mesh bit for bit.
+      Writes OUT_DIR/NAME.msh (gmsh MSH 4.1, for the user) and OUT_DIR/NAME.rodmesh (the hand-off
+      file the Rust side reads, see below). The .rodmesh is made from the .msh through meshio, i.e.
+      by the very same code path as `convert`.
+      JSON: paths, node and element counts, min/mean scaled Jacobian and SICN (gmsh
+      `getElementQualities` "minSJ" / "minSICN"), whether elements are curved, timings.
+
+      Second-order nodes are placed at the straight edge midpoints (`Mesh.SecondOrderLinear = 1`):
+      snapping them onto a surface reconstructed from an STL (a faceted surface, so nothing is gained in
+      accuracy) can invert elements. `--curved` tries snapped nodes and keeps them only if every
+      element has a positive scaled Jacobian, otherwise it falls back to straight-sided elements
+      (and says so in the JSON).
+
+  mesh_rod.py convert IN OUT [--units mm|m]
+      A ready volume mesh (gmsh .msh, Abaqus/CalculiX .inp, VTU, Nastran .bdf/.nas, anything meshio
+      reads) -> OUT in the .rodmesh format. Quadratic tetrahedra ("tetra10") are taken as meshio gives
+      them; linear tetrahedra ("tetra") are promoted to straight-sided tetra10. Other cell types
+      (surface triangles, lines, points) are dropped; nodes no tet uses are dropped.
+
+The .rodmesh hand-off format (ASCII, one record per line, '#' starts a comment line):
+
+  rodmesh 1
+  units mm                 (or m)
+  nodes N
+  x y z                    (N lines, float64 printed with repr(): round-trips exactly)
+  tet10 M
+  n0 n1 ... n9             (M lines, 0-based node indices)
+
+Node order of a tetra10 (the ONE order used inside rodstudy, VTK's = meshio's): corners 0-3, then the
+midside nodes of edges 01, 12, 02, 03, 13, 23. gmsh numbers the last two the other way round (edge 23
+before 13); meshio's gmsh reader already converts gmsh's order to VTK's, Abaqus/CalculiX C3D10 and
+Nastran CTETRA use VTK's order. So no permutation is done here: the one conversion is meshio's, at the
+point where a foreign format is read. The Rust reader checks geometrically that every midside node
+sits near the midpoint of its edge, which catches a wrong order.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import pathlib
+import sys
+import time
+
+import numpy as np
+
+FORMAT_HEADER = "rodmesh 1"
+
+# VTK/meshio tetra10 edges, in the order of the midside nodes 4..9.
+TET10_EDGES = [(0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3)]
+
+
+def log(msg: str) -> None:
+    print(f"mesh_rod: {msg}", file=sys.stderr, flush=True)
+
+
+# ---------------------------------------------------------------------------------------------
+# gmsh meshing
+# ---------------------------------------------------------------------------------------------
+
+def gmsh_options(size_mm: float, curved: bool) -> dict:
+    """Every option that influences the mesh, fixed here so that results do not depend on defaults or
+    on a user's gmsh configuration files (which are not read)."""
+    return {
+        "General.Terminal": 0,
+        "General.NumThreads": 1,
+        "Mesh.Algorithm": 6,  # Frontal-Delaunay (2D)
+        "Mesh.Algorithm3D": 1,  # Delaunay (3D); HXT (10) is multi-threaded
+        "Mesh.RandomSeed": 1,
+        "Mesh.MeshSizeMax": size_mm,
+        "Mesh.MeshSizeMin": 0.0,
+        "Mesh.MeshSizeFactor": 1.0,
+        "Mesh.MeshSizeFromCurvature": 0,
+        "Mesh.MeshSizeFromPoints": 0,
+        "Mesh.MeshSizeExtendFromBoundary": 1,
+        "Mesh.Optimize": 1,
+        "Mesh.OptimizeNetgen": 1,
+        "Mesh.OptimizeThreshold": 0.3,
+        "Mesh.ElementOrder": 2,
+        "Mesh.SecondOrderLinear": 0 if curved else 1,
+        "Mesh.SecondOrderIncomplete": 0,
+        "Mesh.HighOrderOptimize": 0,
+        "Mesh.MshFileVersion": 4.1,
+        "Mesh.Binary": 0,
+        "Mesh.SaveAll": 0,
+    }
+
+
+def gmsh_volume_mesh(stl: pathlib.Path, size_mm: float, curved: bool, angle_deg: float,
+                     curve_angle_deg: float, msh_out: pathlib.Path) -> dict:
+    import gmsh
+
+    t0 = time.perf_counter()
+    gmsh.initialize(["mesh_rod"], readConfigFiles=False)
+    try:
+        for k, v in gmsh_options(size_mm, curved).items():
+            gmsh.option.setNumber(k, v)
+        gmsh.model.add("rod")
+        gmsh.merge(str(stl))
+        # Patches from the triangle soup: split at sharp edges (angle in radians), keep boundaries,
+        # make each patch parametrisable so that it can be remeshed at the target size.
+        gmsh.model.mesh.classifySurfaces(math.radians(angle_deg), True, True, math.radians(curve_angle_deg))
+        gmsh.model.mesh.createGeometry()
+        surfaces = [tag for _, tag in gmsh.model.getEntities(2)]
+        loop = gmsh.model.geo.addSurfaceLoop(surfaces)
+        gmsh.model.geo.addVolume([loop])
+        gmsh.model.geo.synchronize()
+        t1 = time.perf_counter()
+        gmsh.model.mesh.generate(3)
+        t2 = time.perf_counter()
+        types, tags, _ = gmsh.model.mesh.getElements(3)
+        tet10 = [t for ty, t in zip(types, tags) if ty == 11]
+        if not tet10 or len(types) != 1:
+            raise RuntimeError(f"gmsh produced element types {list(types)}, expected only 10-node tets (11)")
+        tags10 = np.asarray(tet10[0])
+        min_sj = np.asarray(gmsh.model.mesh.getElementQualities(tags10, "minSJ"))
+        min_sicn = np.asarray(gmsh.model.mesh.getElementQualities(tags10, "minSICN"))
+        node_tags, _, _ = gmsh.model.mesh.getNodes()
+        gmsh.write(str(msh_out))
+        return {
+            "elements": int(tags10.size),
+            "gmsh_nodes": int(len(node_tags)),
+            "min_scaled_jacobian": float(min_sj.min()),
+            "mean_scaled_jacobian": float(min_sj.mean()),
+            "min_sicn": float(min_sicn.min()),
+            "mean_sicn": float(min_sicn.mean()),
+            "elements_sicn_below_0.1": int((min_sicn < 0.1).sum()),
+            "surface_patches": len(surfaces),
+            "seconds_geometry": t1 - t0,
+            "seconds_mesh": t2 - t1,
+            "gmsh_version": gmsh.option.getString("General.Version"),
+        }
+    finally:
+        gmsh.finalize()
+
+
+def cmd_mesh(args) -> dict:
+    stl = pathlib.Path(args.stl)
+    if not stl.is_file():
+        raise SystemExit(f"mesh_rod: no such STL file: {stl}")
+    if not (args.size > 0 and math.isfinite(args.size)):
+        raise SystemExit(f"mesh_rod: --size must be a positive number of mm, got {args.size}")
+    out_dir = pathlib.Path(args.out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    name = args.name or stl.stem
+    msh = out_dir / f"{name}.msh"
+    rodmesh = out_dir / f"{name}.rodmesh"
+    t0 = time.perf_counter()
+    log(f"{stl.name}: meshing at {args.size} mm" + (" (curved attempt)" if args.curved else ""))
+    curved = False
+    if args.curved:
+        info = gmsh_volume_mesh(stl, args.size, True, args.angle, args.curve_angle, msh)
+        curved = info["min_scaled_jacobian"] > 0.0
+        if not curved:
+            log(f"curved mesh has min scaled Jacobian {info['min_scaled_jacobian']:.3g} <= 0: "
+                "falling back to straight-sided elements")
+    if not curved:
+        info = gmsh_volume_mesh(stl, args.size, False, args.angle, args.curve_angle, msh)
+    conv = convert(msh, rodmesh, "mm")
+    info.update({
+        "stl": str(stl),
+        "msh": str(msh),
+        "rodmesh": str(rodmesh),
+        "size_mm": args.size,
+        "curved": curved,
+        "nodes": conv["nodes"],
+        "max_midside_offset_rel": conv["max_midside_offset_rel"],
+        "seconds_total": time.perf_counter() - t0,
+    })
+    if conv["elements"] != info["elements"]:
+        raise RuntimeError(f"meshio read {conv['elements']} tetra10 from {msh}, gmsh wrote {info['elements']}")
+    log(f"{info['elements']} tet10, {info['nodes']} nodes, min SICN {info['min_sicn']:.3f}, "
+        f"min SJ {info['min_scaled_jacobian']:.3f}, {info['seconds_total']:.1f} s")
+    return info
+
+
+# ---------------------------------------------------------------------------------------------
+# meshio conversion and the .rodmesh writer
+# ---------------------------------------------------------------------------------------------
+
+def promote_tetra4(points: np.ndarray, tets: np.ndarray):
+    """Linear tets -> straight-sided tetra10 (VTK order): one new node per unique edge, at its midpoint."""
+    edges = np.concatenate([tets[:, [a, b]] for a, b in TET10_EDGES], axis=0)
+    edges.sort(axis=1)
+    uniq, inverse = np.unique(edges, axis=0, return_inverse=True)
+    mid = 0.5 * (points[uniq[:, 0]] + points[uniq[:, 1]])
+    new_ids = len(points) + inverse.reshape(len(TET10_EDGES), len(tets)).T
+    return np.vstack([points, mid]), np.hstack([tets, new_ids])
+
+
+def convert(inp: pathlib.Path, out: pathlib.Path, units: str) -> dict:
+    import meshio
+
+    if units not in ("mm", "m"):
+        raise SystemExit(f"mesh_rod: --units must be mm or m, got {units}")
+    m = meshio.read(str(inp))
+    points = np.asarray(m.points, dtype=np.float64)
+    if points.shape[1] == 2:
+        raise SystemExit(f"mesh_rod: {inp} is a 2D mesh")
+    blocks10 = [np.asarray(c.data, dtype=np.int64) for c in m.cells if c.type == "tetra10"]
+    blocks4 = [np.asarray(c.data, dtype=np.int64) for c in m.cells if c.type == "tetra"]
+    kinds = sorted({c.type for c in m.cells})
+    if blocks10 and blocks4:
+        raise SystemExit(f"mesh_rod: {inp} mixes tetra and tetra10 cells; give one kind")
+    if blocks10:
+        tets = np.concatenate(blocks10)
+    elif blocks4:
+        log(f"{inp.name}: linear tetrahedra promoted to straight-sided tetra10")
+        points, tets = promote_tetra4(points, np.concatenate(blocks4))
+    else:
+        raise SystemExit(f"mesh_rod: {inp} has no tetrahedra (cell types: {', '.join(kinds) or 'none'})")
+    # Keep only the nodes the tets use, renumbered in their original order.
+    used = np.unique(tets)
+    remap = np.full(len(points), -1, dtype=np.int64)
+    remap[used] = np.arange(len(used))
+    points = points[used]
+    tets = remap[tets]
+    # Midside nodes must sit near their edge midpoints (straight: exactly on them); a large offset
+    # means a wrong node order. Report the worst one relative to the edge length.
+    offs = []
+    for k, (a, b) in enumerate(TET10_EDGES):
+        pa, pb, pm = points[tets[:, a]], points[tets[:, b]], points[tets[:, 4 + k]]
+        offs.append(np.linalg.norm(pm - 0.5 * (pa + pb), axis=1) / np.linalg.norm(pb - pa, axis=1))
+    max_off = float(np.max(offs)) if len(tets) else 0.0
+    write_rodmesh(out, points, tets, units, source=str(inp))
+    return {"nodes": int(len(points)), "elements": int(len(tets)), "units": units,
+            "max_midside_offset_rel": max_off, "input_cell_types": kinds,
+            "rodmesh": str(out)}
+
+
+def write_rodmesh(path: pathlib.Path, points: np.ndarray, tets: np.ndarray, units: str, source: str) -> None:
+    lines = [FORMAT_HEADER, f"# from {source}", f"units {units}", f"nodes {len(points)}"]
+    lines.extend(f"{x!r} {y!r} {z!r}" for x, y, z in points.tolist())
+    lines.append(f"tet10 {len(tets)}")
+    lines.extend(" ".join(map(str, row)) for row in tets.tolist())
+    tmp = path.with_suffix(path.suffix + ".tmp")
+    tmp.write_text("\n".join(lines) + "\n")
+    tmp.replace(path)
+
+
+def cmd_convert(args) -> dict:
+    t0 = time.perf_counter()
+    info = convert(pathlib.Path(args.input), pathlib.Path(args.output), args.units)
+    info["seconds_total"] = time.perf_counter() - t0
+    log(f"{args.input} -> {args.output}: {info['elements']} tetra10, {info['nodes']} nodes")
+    return info
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    pm = sub.add_parser("mesh", help="STL -> tet10 volume mesh (.msh + .rodmesh)")
+    pm.add_argument("stl")
+    pm.add_argument("out_dir")
+    pm.add_argument("--size", type=float, default=5.0, help="target element size, mm (default 5)")
+    pm.add_argument("--name", help="output base name (default: the STL's stem)")
+    pm.add_argument("--curved", action="store_true",
+                    help="try midside nodes on the surface; fall back to straight if any element inverts")
+    pm.add_argument("--angle", type=float, default=40.0,
+                    help="classifySurfaces: dihedral angle (degrees) splitting patches (default 40)")
+    pm.add_argument("--curve-angle", type=float, default=180.0,
+                    help="classifySurfaces: angle (degrees) splitting curves (default 180)")
+    pc = sub.add_parser("convert", help="any meshio volume mesh -> .rodmesh")
+    pc.add_argument("input")
+    pc.add_argument("output")
+    pc.add_argument("--units", default="mm", help="units of the input coordinates: mm (default) or m")
+    args = ap.parse_args(argv)
+    info = cmd_mesh(args) if args.cmd == "mesh" else cmd_convert(args)
+    print(json.dumps(info, sort_keys=True))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
