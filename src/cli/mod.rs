@@ -4,6 +4,7 @@
 //! are still reported), 2 for a usage error or a failure that stops the whole command.
 
 mod bench;
+mod check;
 mod dynamics;
 mod mass;
 mod pipeline;
@@ -32,6 +33,8 @@ enum Command {
     Dynamics(dynamics::DynamicsCommand),
     /// Run every stage that exists on every design of a folder and write the reports.
     Study(study::StudyArgs),
+    /// Compare the latest study results with the committed baseline (the CI regression gate).
+    Check(check::CheckArgs),
     /// Benchmarks, reported as ratios against a reference run in the same process.
     #[command(subcommand)]
     Bench(bench::BenchCommand),
@@ -54,6 +57,7 @@ pub fn main() -> i32 {
         Command::Mass(args) => mass::run(args),
         Command::Dynamics(command) => dynamics::run(command),
         Command::Study(args) => study::run(args),
+        Command::Check(args) => check::run(args),
         Command::Bench(command) => bench::run(command),
         Command::Setup => pipeline::setup(),
         Command::Pipeline(args) => pipeline::run(args),

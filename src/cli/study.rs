@@ -1,5 +1,7 @@
 //! `rodstudy study [--designs DIR] [--out DIR]`
 
+use crate::study::atomic_write::write_atomic;
+use crate::study::baseline::{Baseline, read_results};
 use crate::study::tables::{dynamics_table, mass_table};
 use crate::study::{run_study, write_reports};
 use anyhow::Result;
@@ -14,6 +16,9 @@ pub struct StudyArgs {
     /// Folder the reports are written to.
     #[arg(long, default_value = "reports")]
     out: PathBuf,
+    /// Also write OUT/baseline.json from these results (on purpose: it is what CI checks against).
+    #[arg(long)]
+    update_baseline: bool,
 }
 
 pub fn run(args: StudyArgs) -> Result<i32> {
@@ -41,6 +46,24 @@ pub fn run(args: StudyArgs) -> Result<i32> {
     let written = write_reports(&results, &args.out)?;
     for path in written {
         eprintln!("wrote {}", path.display());
+    }
+    if args.update_baseline {
+        if !results.failed.is_empty() {
+            anyhow::bail!(
+                "not updating the baseline: {} design(s) failed",
+                results.failed.len()
+            );
+        }
+        let view = read_results(&args.out.join("results.json"))?;
+        let path = args.out.join("baseline.json");
+        write_atomic(
+            &path,
+            serde_json::to_string_pretty(&Baseline::from_results(&view))?.as_bytes(),
+        )?;
+        eprintln!(
+            "wrote {} (the new baseline for `rodstudy check`)",
+            path.display()
+        );
     }
     Ok(i32::from(!results.failed.is_empty()))
 }

@@ -5,6 +5,7 @@
 //! it is listed in the report with its error, and the command's exit status says so.
 
 pub mod atomic_write;
+pub mod baseline;
 pub mod dynamics_stage;
 pub mod tables;
 
@@ -43,7 +44,7 @@ pub struct DesignResult {
 }
 
 /// A design that could not be studied, and why.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, serde::Deserialize)]
 pub struct FailedDesign {
     pub file: String,
     pub error: String,
