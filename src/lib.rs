@@ -6,6 +6,10 @@
 //!   mapping into the mechanism frame;
 //! - [`mechanism`]: stage 2, the planar crank–slider: closed-form Newton–Euler and a planar
 //!   multibody core (thesis §3.2), the driven scene and its peak pin force;
+//! - [`integrators`]: ODE solvers (the thesis' initial-acceleration method, RK45, RK23, BDF,
+//!   Rosenbrock, TR-BDF2) with dense output, step control, counters and caps;
+//! - [`free_run`]: scene `free` (thesis ch. 4): the reduction-method equation of motion, its exact
+//!   energy-integral reference and the work–precision sweep;
 //! - [`study`]: running the stages over every design of a folder;
 //! - [`python_env`]: the project-local Python environment the `pipeline/` scripts run in;
 //! - [`bench`]: benchmarks, reported as ratios against a reference run;
@@ -13,7 +17,9 @@
 
 pub mod bench;
 pub mod cli;
+pub mod free_run;
 pub mod geometry;
+pub mod integrators;
 pub mod mechanism;
 pub mod python_env;
 pub mod study;

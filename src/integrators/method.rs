@@ -1,0 +1,115 @@
+//! Method selection and the single entry point [`solve`].
+
+use super::{OdeSystem, OutputGrid, Solution, SolverError, SolverOptions};
+use super::{bdf, initial_acceleration, rk23, rk45, rosenbrock, trbdf2};
+use nalgebra::DVector;
+use serde::{Deserialize, Serialize};
+
+/// The generic ODE methods.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum OdeMethod {
+    /// Thesis §4.1.1, fixed step `SolverOptions::h` (required); second-order layout `[q; q̇]`.
+    InitialAcceleration,
+    /// Dormand–Prince 5(4) (ode45).
+    Rk45,
+    /// Bogacki–Shampine 3(2) (ode23).
+    Rk23,
+    /// Variable-order BDF 1–5 (ode15s with pure BDF coefficients).
+    Bdf,
+    /// Variable-order NDF 1–5 (ode15s default formulas, Klopfenstein–Shampine).
+    Ndf,
+    /// Modified Rosenbrock 2(3) (ode23s).
+    Rosenbrock,
+    /// TR-BDF2 (ode23tb).
+    TrBdf2,
+}
+
+impl OdeMethod {
+    /// Short name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::InitialAcceleration => "initial-acceleration",
+            Self::Rk45 => "rk45",
+            Self::Rk23 => "rk23",
+            Self::Bdf => "bdf",
+            Self::Ndf => "ndf",
+            Self::Rosenbrock => "rosenbrock",
+            Self::TrBdf2 => "trbdf2",
+        }
+    }
+
+    /// `true` for methods without error control.
+    pub fn is_fixed_step(self) -> bool {
+        matches!(self, Self::InitialAcceleration)
+    }
+
+    /// `true` for implicit / linearly implicit methods (stiff solvers).
+    pub fn is_implicit(self) -> bool {
+        matches!(
+            self,
+            Self::Bdf | Self::Ndf | Self::Rosenbrock | Self::TrBdf2
+        )
+    }
+}
+
+/// Integrates `sys` from `grid.t0` (state `y0`) to `grid.t_end()` with `method`, writing the
+/// solution on the output grid.
+pub fn solve<S: OdeSystem + ?Sized>(
+    method: OdeMethod,
+    sys: &S,
+    y0: &DVector<f64>,
+    grid: &OutputGrid,
+    opts: &SolverOptions,
+) -> Result<Solution, SolverError> {
+    match method {
+        OdeMethod::InitialAcceleration => initial_acceleration::solve(sys, y0, grid, opts),
+        OdeMethod::Rk45 => rk45::solve(sys, y0, grid, opts),
+        OdeMethod::Rk23 => rk23::solve(sys, y0, grid, opts),
+        OdeMethod::Bdf => bdf::solve(sys, y0, grid, opts, bdf::Formula::Bdf),
+        OdeMethod::Ndf => bdf::solve(sys, y0, grid, opts, bdf::Formula::Ndf),
+        OdeMethod::Rosenbrock => rosenbrock::solve(sys, y0, grid, opts),
+        OdeMethod::TrBdf2 => trbdf2::solve(sys, y0, grid, opts),
+    }
+}
+
+/// Common input checks; `Err` carries the message for [`super::FailureKind::InvalidInput`].
+pub(crate) fn check_input<S: OdeSystem + ?Sized>(
+    sys: &S,
+    y0: &DVector<f64>,
+    opts: &SolverOptions,
+) -> Result<(), String> {
+    opts.validate()?;
+    if y0.len() != sys.dim() {
+        return Err(format!(
+            "y0 has length {}, system dimension is {}",
+            y0.len(),
+            sys.dim()
+        ));
+    }
+    for v in [&opts.rtol_components, &opts.atol_components]
+        .into_iter()
+        .flatten()
+    {
+        if v.len() != y0.len() {
+            return Err(format!(
+                "per-component tolerance has length {}, state has {}",
+                v.len(),
+                y0.len()
+            ));
+        }
+    }
+    if !y0.iter().all(|v| v.is_finite()) {
+        return Err("initial state is not finite".into());
+    }
+    Ok(())
+}
+
+/// Builds the [`SolverError`] for invalid input before any evaluation.
+pub(crate) fn invalid(method: &'static str, t0: f64, msg: String) -> SolverError {
+    SolverError {
+        method,
+        kind: super::FailureKind::InvalidInput(msg),
+        t: t0,
+        stats: Default::default(),
+    }
+}

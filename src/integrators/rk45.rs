@@ -1,0 +1,235 @@
+//! Dormand–Prince 5(4), the method of MATLAB's ode45.
+//!
+//! J. R. Dormand, P. J. Prince, "A family of embedded Runge–Kutta formulae", J. Comput. Appl.
+//! Math. 6 (1980) 19–26 (coefficients as in Hairer, Nørsett & Wanner, *Solving ODEs I*,
+//! Table II.5.2). Seven stages, FSAL, local extrapolation (the 5th-order result is propagated),
+//! error estimate `h Σ e_i k_i` with `e = b − b̂` (4th-order), step factor
+//! `0.9 err^(-1/5)` in `[0.2, 5]` (no increase right after a rejection).
+//! Dense output: the 4th-order continuous extension of MATLAB's `ntrp45`
+//! (Shampine 1986; `y(t+θh) = y + h Σ_i k_i Σ_j BI_ij θ^j`).
+
+use super::control::{check_underflow, clamp_to_end, factor, initial_step, max_step};
+use super::eval::Evaluator;
+use super::grid::Recorder;
+use super::method::{check_input, invalid};
+use super::norm::{Weights, all_finite};
+use super::{OdeSystem, OutputGrid, Solution, SolverError, SolverOptions};
+use nalgebra::DVector;
+
+const NAME: &str = "rk45";
+
+const C: [f64; 7] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0];
+const A: [[f64; 6]; 7] = [
+    [0.0; 6],
+    [1.0 / 5.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
+    [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
+    [
+        19372.0 / 6561.0,
+        -25360.0 / 2187.0,
+        64448.0 / 6561.0,
+        -212.0 / 729.0,
+        0.0,
+        0.0,
+    ],
+    [
+        9017.0 / 3168.0,
+        -355.0 / 33.0,
+        46732.0 / 5247.0,
+        49.0 / 176.0,
+        -5103.0 / 18656.0,
+        0.0,
+    ],
+    [
+        35.0 / 384.0,
+        0.0,
+        500.0 / 1113.0,
+        125.0 / 192.0,
+        -2187.0 / 6784.0,
+        11.0 / 84.0,
+    ],
+];
+/// `e = b − b̂` (b = A[6], 5th order; b̂ the 4th-order weights).
+const E: [f64; 7] = [
+    71.0 / 57600.0,
+    0.0,
+    -71.0 / 16695.0,
+    71.0 / 1920.0,
+    -17253.0 / 339200.0,
+    22.0 / 525.0,
+    -1.0 / 40.0,
+];
+/// ntrp45 interpolation matrix: coefficients of θ, θ², θ³, θ⁴ for each stage.
+const BI: [[f64; 4]; 7] = [
+    [1.0, -183.0 / 64.0, 37.0 / 12.0, -145.0 / 128.0],
+    [0.0, 0.0, 0.0, 0.0],
+    [0.0, 1500.0 / 371.0, -1000.0 / 159.0, 1000.0 / 371.0],
+    [0.0, -125.0 / 32.0, 125.0 / 12.0, -375.0 / 64.0],
+    [0.0, 9477.0 / 3392.0, -729.0 / 106.0, 25515.0 / 6784.0],
+    [0.0, -11.0 / 7.0, 11.0 / 3.0, -55.0 / 28.0],
+    [0.0, 3.0 / 2.0, -4.0, 5.0 / 2.0],
+];
+
+/// Integrates with error control `opts.rtol`, `opts.atol`.
+pub fn solve<S: OdeSystem + ?Sized>(
+    sys: &S,
+    y0: &DVector<f64>,
+    grid: &OutputGrid,
+    opts: &SolverOptions,
+) -> Result<Solution, SolverError> {
+    let (t0, t_end) = (grid.t0, grid.t_end());
+    check_input(sys, y0, opts).map_err(|m| invalid(NAME, t0, m))?;
+    let n = y0.len();
+    let weights = Weights::new(opts, n);
+    let mut ev = Evaluator::new(sys, NAME, opts, t0);
+    let mut rec = Recorder::new(grid, y0);
+    let h_max = max_step(opts, t_end - t0);
+    let mut k: [DVector<f64>; 7] = std::array::from_fn(|_| DVector::zeros(n));
+    let mut y = y0.clone();
+    let mut y_new = DVector::zeros(n);
+    let mut ys = DVector::zeros(n);
+    let mut err = DVector::zeros(n);
+    ev.rhs_finite(t0, &y, &mut k[0])?;
+    let mut h = initial_step(&mut ev, t0, &y, &k[0], 4, t_end - t0, opts)?;
+    let mut t = t0;
+    let mut rejected_last = false;
+    loop {
+        ev.check_step_budget()?;
+        check_underflow(&ev, t, h)?;
+        let (h_step, t_new, last) = clamp_to_end(t, h, t_end);
+        for s in 1..7 {
+            // component loops: cheaper than vector ops for the small systems of this crate
+            for i in 0..n {
+                let mut acc = 0.0;
+                for (j, kj) in k.iter().enumerate().take(s) {
+                    acc += A[s][j] * kj[i];
+                }
+                ys[i] = y[i] + h_step * acc;
+            }
+            let ts = if s >= 5 { t_new } else { t + C[s] * h_step };
+            ev.rhs(ts, &ys, &mut k[s])?;
+        }
+        // stage 7 was evaluated at y_new = ys (FSAL)
+        y_new.copy_from(&ys);
+        for i in 0..n {
+            let mut acc = 0.0;
+            for (j, kj) in k.iter().enumerate() {
+                acc += E[j] * kj[i];
+            }
+            err[i] = h_step * acc;
+        }
+        let en = weights.norm(&err, &y, &y_new);
+        if !en.is_finite() || !all_finite(&y_new) || !all_finite(&k[6]) {
+            ev.reject_step();
+            h = 0.2 * h_step;
+            rejected_last = true;
+            continue;
+        }
+        if en > 1.0 {
+            ev.reject_step();
+            h = h_step * factor(en, 5.0, 0.9, 0.2, 1.0);
+            rejected_last = true;
+            continue;
+        }
+        rec.record(t, t_new, &y_new, |theta, out| {
+            let (t1, t2, t3, t4) = (theta, theta * theta, theta.powi(3), theta.powi(4));
+            out.copy_from(&y);
+            for (j, kj) in k.iter().enumerate() {
+                let b = BI[j][0] * t1 + BI[j][1] * t2 + BI[j][2] * t3 + BI[j][3] * t4;
+                if b != 0.0 {
+                    out.axpy(h_step * b, kj, 1.0);
+                }
+            }
+        });
+        ev.accept_step(t_new);
+        if last {
+            break;
+        }
+        let fac_max = if rejected_last { 1.0 } else { 5.0 };
+        h = (h_step * factor(en, 5.0, 0.9, 0.2, fac_max)).min(h_max);
+        rejected_last = false;
+        t = t_new;
+        std::mem::swap(&mut y, &mut y_new);
+        k.swap(0, 6);
+    }
+    Ok(rec.finish(ev.stats))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::integrators::tests_common::{Decay, Oscillator, max_error};
+
+    #[test]
+    fn tableau_is_consistent() {
+        for s in 1..7 {
+            let row: f64 = A[s].iter().sum();
+            assert!((row - C[s]).abs() < 1e-14, "row {s}");
+        }
+        assert!(E.iter().sum::<f64>().abs() < 1e-15);
+        // the continuous extension reproduces y_new at θ = 1
+        for j in 0..7 {
+            let b: f64 = BI[j].iter().sum();
+            let bj = if j < 6 { A[6][j] } else { 0.0 };
+            assert!((b - bj).abs() < 1e-14, "stage {j}");
+        }
+    }
+
+    #[test]
+    fn decay_within_tolerance() {
+        let grid = OutputGrid::new(0.0, 2.0, 0.01).unwrap();
+        let y0 = DVector::from_vec(vec![1.0]);
+        for tol in [1e-4, 1e-7, 1e-10] {
+            let sol = solve(
+                &Decay { lambda: 1.0 },
+                &y0,
+                &grid,
+                &SolverOptions::absolute(tol),
+            )
+            .unwrap();
+            let e = max_error(&sol, |t| vec![(-t).exp()]);
+            assert!(e < 10.0 * tol, "tol {tol}: error {e}");
+        }
+    }
+
+    #[test]
+    fn oscillator_error_scales_like_tol_to_the_fifth_root() {
+        let sys = Oscillator { omega: 2.0 };
+        let grid = OutputGrid::new(0.0, 10.0, 0.01).unwrap();
+        let y0 = DVector::from_vec(vec![1.0, 0.0]);
+        let run = |tol: f64| {
+            let sol = solve(&sys, &y0, &grid, &SolverOptions::absolute(tol)).unwrap();
+            (
+                max_error(&sol, |t| sys.exact(t).to_vec()),
+                sol.stats.steps as f64,
+            )
+        };
+        let (e1, n1) = run(1e-6);
+        let (e2, n2) = run(1e-9);
+        assert!(e2 < e1 && e1 < 1e-4 && e2 < 1e-7, "{e1} {e2}");
+        // steps grow like tol^(-1/5): 1000^(1/5) ≈ 4
+        let ratio = n2 / n1;
+        assert!(ratio > 3.0 && ratio < 5.5, "step ratio {ratio}");
+    }
+
+    #[test]
+    fn dense_output_is_fourth_order() {
+        // one long step on y' = -y, interpolant error at θ = 0.5 shrinks like h^5
+        let y0 = DVector::from_vec(vec![1.0]);
+        let mut errs = vec![];
+        for h in [0.2, 0.1] {
+            let grid = OutputGrid::new(0.0, h, h / 2.0).unwrap();
+            let opts = SolverOptions {
+                h: Some(h),
+                rtol: 1.0,
+                atol: 1.0,
+                ..Default::default()
+            };
+            let sol = solve(&Decay { lambda: 1.0 }, &y0, &grid, &opts).unwrap();
+            assert_eq!(sol.stats.steps, 1);
+            errs.push((sol.y_at(1)[0] - (-h / 2.0).exp()).abs());
+        }
+        let p = (errs[0] / errs[1]).log2();
+        assert!(p > 4.5, "interpolant local order {p}");
+    }
+}
