@@ -1,5 +1,6 @@
 //! `rodstudy dynamics driven DESIGN... [--json] [--csv FILE]` and `rodstudy dynamics table-5-1`
 
+use crate::free_run::{FreeRunOptions, Method as FreeMethod, run_free};
 use crate::geometry::design::{find_stl_files, mass_of_design};
 use crate::mechanism::{DrivenScene, MechanismParams, Method, table_5_1_check};
 use crate::study::dynamics_stage::{DesignDynamics, dynamics_of_design, write_history_csv};
@@ -13,6 +14,9 @@ use std::path::PathBuf;
 pub enum DynamicsCommand {
     /// The driven crank–slider (φ = ωt): crank–rod pin force history and its peak, per design.
     Driven(DrivenArgs),
+    /// The free-running crank (thesis ch. 4): M = 1 N·m on the crank, F = 15 N on the piston,
+    /// from rest; the reduction-method equation of motion integrated by the chosen method.
+    Free(FreeArgs),
     /// The thesis' Table 5.1 reproduced: rods of the table's mass with the spec's l1.
     #[command(name = "table-5-1")]
     Table51 {
@@ -59,9 +63,132 @@ pub struct DrivenArgs {
     steps: Option<usize>,
 }
 
+#[derive(Args)]
+pub struct FreeArgs {
+    /// initial-acceleration, rk45, rk23, bdf, rosenbrock, trbdf2.
+    #[arg(long, default_value = "rk45")]
+    method: String,
+    /// Relative tolerance (default 0: φ grows without bound, so control is absolute).
+    #[arg(long)]
+    rtol: Option<f64>,
+    /// Absolute tolerance on φ [rad] and φ̇ [rad/s] (default 1e-8).
+    #[arg(long)]
+    atol: Option<f64>,
+    /// Step of the fixed-step initial-acceleration method [s] (default 1e-5).
+    #[arg(long)]
+    dt: Option<f64>,
+    /// End time [s] (default 1).
+    #[arg(long)]
+    t_end: Option<f64>,
+    /// Cap on steps (default 1e6).
+    #[arg(long)]
+    max_steps: Option<u64>,
+    /// Print the result as JSON (without the trajectories).
+    #[arg(long)]
+    json: bool,
+    /// Write t, φ, ω on the 1e-4 s output grid to this CSV file.
+    #[arg(long)]
+    csv: Option<PathBuf>,
+}
+
+/// What `dynamics free --json` prints: the run without its trajectories, and its error against
+/// the exact energy-integral reference.
+#[derive(serde::Serialize)]
+struct FreeSummary<'a> {
+    method: String,
+    model: &'a str,
+    t_end_s: f64,
+    phi_rad: f64,
+    omega_rad_s: f64,
+    steps: u64,
+    rejected_steps: u64,
+    rhs_evals: u64,
+    jac_evals: u64,
+    lu_decompositions: u64,
+    cpu_s: f64,
+    energy_drift_max_j: Option<f64>,
+    max_err_phi_rad: Option<f64>,
+    max_err_omega_rad_s: Option<f64>,
+    warnings: &'a [String],
+}
+
+fn free(args: FreeArgs) -> Result<i32> {
+    let method: FreeMethod = args.method.parse().map_err(|e| anyhow::anyhow!("{e}"))?;
+    let mut options = FreeRunOptions::default();
+    if let Some(t_end) = args.t_end {
+        options.scene.t_end = t_end;
+    }
+    options.rtol = args.rtol.unwrap_or(options.rtol);
+    options.atol = args.atol.unwrap_or(options.atol);
+    options.fixed_step = args.dt.unwrap_or(options.fixed_step);
+    options.max_steps = args.max_steps.unwrap_or(options.max_steps);
+    let run = run_free(method, &options).map_err(|e| anyhow::anyhow!("{method}: {e}"))?;
+    let errors = options
+        .scene
+        .reference()
+        .ok()
+        .map(|reference| reference.max_errors(&run.phi, &run.omega));
+    let summary = FreeSummary {
+        method: run.method.to_string(),
+        model: run.model,
+        t_end_s: options.scene.t_end,
+        phi_rad: run.phi_rad,
+        omega_rad_s: run.omega_rad_s,
+        steps: run.steps,
+        rejected_steps: run.rejected_steps,
+        rhs_evals: run.rhs_evals,
+        jac_evals: run.jac_evals,
+        lu_decompositions: run.lu_decompositions,
+        cpu_s: run.cpu_s,
+        energy_drift_max_j: run.energy_drift_max_j,
+        max_err_phi_rad: errors.map(|e| e.0),
+        max_err_omega_rad_s: errors.map(|e| e.1),
+        warnings: &run.warnings,
+    };
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&summary)?);
+    } else {
+        println!("scene free, method {} ({})", summary.method, summary.model);
+        println!(
+            "t_end = {} s: φ = {:.12} rad, ω = {:.12} rad/s",
+            summary.t_end_s, summary.phi_rad, summary.omega_rad_s
+        );
+        println!(
+            "steps {} (+{} rejected), RHS evaluations {}, Jacobians {}, LU {}, time {:.3} ms",
+            summary.steps,
+            summary.rejected_steps,
+            summary.rhs_evals,
+            summary.jac_evals,
+            summary.lu_decompositions,
+            summary.cpu_s * 1e3
+        );
+        if let (Some(p), Some(w)) = (summary.max_err_phi_rad, summary.max_err_omega_rad_s) {
+            println!(
+                "against the exact energy-integral reference: max |Δφ| = {p:.3e} rad, max |Δω| = {w:.3e} rad/s"
+            );
+        }
+        if let Some(e) = summary.energy_drift_max_j {
+            println!("energy drift: {e:.3e} J");
+        }
+    }
+    for w in summary.warnings {
+        eprintln!("warning: {w}");
+    }
+    if let Some(path) = &args.csv {
+        let mut w = csv::Writer::from_writer(Vec::new());
+        w.write_record(["t_s", "phi_rad", "omega_rad_s"])?;
+        for k in 0..run.t.len() {
+            w.write_record([run.t[k], run.phi[k], run.omega[k]].map(|v| format!("{v:.15e}")))?;
+        }
+        crate::study::atomic_write::write_atomic(path, &w.into_inner()?)?;
+    }
+    Ok(0)
+}
+
 pub fn run(command: DynamicsCommand) -> Result<i32> {
     match command {
         DynamicsCommand::Driven(args) => driven(args),
+        DynamicsCommand::Free(args) => free(args),
         DynamicsCommand::Table51 { json, no_gravity } => table51(json, !no_gravity),
     }
 }

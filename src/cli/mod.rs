@@ -6,6 +6,7 @@
 mod bench;
 mod check;
 mod dynamics;
+mod integrators;
 mod mass;
 mod pipeline;
 mod study;
@@ -31,6 +32,8 @@ enum Command {
     /// Stage 2: the crank–slider with each design's rod (peak crank–rod pin force).
     #[command(subcommand)]
     Dynamics(dynamics::DynamicsCommand),
+    /// Work–precision comparison of the integrators on the free run (thesis ch. 4).
+    Integrators(integrators::IntegratorsArgs),
     /// Run every stage that exists on every design of a folder and write the reports.
     Study(study::StudyArgs),
     /// Compare the latest study results with the committed baseline (the CI regression gate).
@@ -56,6 +59,7 @@ pub fn main() -> i32 {
     let result = match cli.command {
         Command::Mass(args) => mass::run(args),
         Command::Dynamics(command) => dynamics::run(command),
+        Command::Integrators(args) => integrators::run(args),
         Command::Study(args) => study::run(args),
         Command::Check(args) => check::run(args),
         Command::Bench(command) => bench::run(command),

@@ -7,6 +7,7 @@
 pub mod atomic_write;
 pub mod baseline;
 pub mod dynamics_stage;
+pub mod plots;
 pub mod tables;
 
 use crate::geometry::design::{DesignMass, find_stl_files, mass_of_design};

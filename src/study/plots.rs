@@ -1,0 +1,199 @@
+//! SVG plots of the reports (plotters' SVG backend: no system libraries, text as SVG `<text>`).
+
+use anyhow::{Result, anyhow};
+use plotters::prelude::*;
+
+/// One named line of a chart.
+pub struct Series {
+    pub name: String,
+    pub points: Vec<(f64, f64)>,
+}
+
+/// Axis scaling of a line chart.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum Scale {
+    Linear,
+    Log,
+}
+
+const COLOURS: [RGBColor; 8] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(23, 190, 207),
+];
+
+fn range(series: &[Series], pick: impl Fn(&(f64, f64)) -> f64, scale: Scale) -> (f64, f64) {
+    let values = series
+        .iter()
+        .flat_map(|s| s.points.iter().map(&pick))
+        .filter(|v| v.is_finite() && (scale == Scale::Linear || *v > 0.0));
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+        (a.min(v), b.max(v))
+    });
+    match scale {
+        Scale::Log => (lo / 1.5, hi * 1.5),
+        Scale::Linear => {
+            let pad = 0.05 * (hi - lo).max(1e-12);
+            (lo - pad, hi + pad)
+        }
+    }
+}
+
+/// Tick label: powers of ten as `1e-6` on log axes, plain short numbers on linear ones.
+fn tick(v: f64, scale: Scale) -> String {
+    match scale {
+        Scale::Log => {
+            let e = v.log10().round();
+            if (v.log10() - e).abs() < 1e-6 {
+                format!("1e{e}")
+            } else {
+                format!("{v:.1e}")
+            }
+        }
+        Scale::Linear => {
+            let s = format!("{v:.6}");
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        }
+    }
+}
+
+/// A line chart with markers, one line per series, as SVG text.
+pub fn line_chart(
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series],
+    x_scale: Scale,
+    y_scale: Scale,
+) -> Result<String> {
+    let (x0, x1) = range(series, |p| p.0, x_scale);
+    let (y0, y1) = range(series, |p| p.1, y_scale);
+    if !(x0.is_finite() && x1.is_finite() && y0.is_finite() && y1.is_finite()) {
+        return Err(anyhow!("{title}: nothing to plot"));
+    }
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (960, 640)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
+        let builder = |root| {
+            let mut b = ChartBuilder::on(root);
+            b.caption(title, ("sans-serif", 22))
+                .margin(12)
+                .x_label_area_size(48)
+                .y_label_area_size(80);
+            b
+        };
+        macro_rules! draw {
+            ($chart:expr) => {{
+                let mut chart = $chart.map_err(|e| anyhow!("{e}"))?;
+                chart
+                    .configure_mesh()
+                    .x_desc(x_label)
+                    .y_desc(y_label)
+                    .x_label_formatter(&|v| tick(*v, x_scale))
+                    .y_label_formatter(&|v| tick(*v, y_scale))
+                    .draw()
+                    .map_err(|e| anyhow!("{e}"))?;
+                for (k, s) in series.iter().enumerate() {
+                    let colour = COLOURS[k % COLOURS.len()];
+                    let points: Vec<(f64, f64)> = s
+                        .points
+                        .iter()
+                        .copied()
+                        .filter(|p| p.0.is_finite() && p.1.is_finite())
+                        .filter(|p| {
+                            (x_scale == Scale::Linear || p.0 > 0.0)
+                                && (y_scale == Scale::Linear || p.1 > 0.0)
+                        })
+                        .collect();
+                    chart
+                        .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))
+                        .map_err(|e| anyhow!("{e}"))?
+                        .label(s.name.as_str())
+                        .legend(move |(x, y)| {
+                            PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+                        });
+                    if points.len() <= 60 {
+                        chart
+                            .draw_series(points.iter().map(|&p| Circle::new(p, 3, colour.filled())))
+                            .map_err(|e| anyhow!("{e}"))?;
+                    }
+                }
+                chart
+                    .configure_series_labels()
+                    .background_style(WHITE.mix(0.85))
+                    .border_style(BLACK)
+                    .position(SeriesLabelPosition::UpperRight)
+                    .draw()
+                    .map_err(|e| anyhow!("{e}"))?;
+            }};
+        }
+        match (x_scale, y_scale) {
+            (Scale::Log, Scale::Log) => {
+                draw!(builder(&root).build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale()))
+            }
+            (Scale::Log, Scale::Linear) => {
+                draw!(builder(&root).build_cartesian_2d((x0..x1).log_scale(), y0..y1))
+            }
+            (Scale::Linear, Scale::Log) => {
+                draw!(builder(&root).build_cartesian_2d(x0..x1, (y0..y1).log_scale()))
+            }
+            (Scale::Linear, Scale::Linear) => {
+                draw!(builder(&root).build_cartesian_2d(x0..x1, y0..y1))
+            }
+        }
+        root.present().map_err(|e| anyhow!("{e}"))?;
+    }
+    Ok(svg)
+}
+
+/// A bar chart of one value per label, as SVG text.
+pub fn bar_chart(title: &str, y_label: &str, bars: &[(String, f64)]) -> Result<String> {
+    let top = bars.iter().map(|b| b.1).fold(0.0f64, f64::max) * 1.1;
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (960, 560)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
+        let n = bars.len() as u32;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 22))
+            .margin(12)
+            .x_label_area_size(48)
+            .y_label_area_size(80)
+            .build_cartesian_2d((0..n).into_segmented(), 0.0..top)
+            .map_err(|e| anyhow!("{e}"))?;
+        let labels: Vec<String> = bars.iter().map(|b| b.0.clone()).collect();
+        chart
+            .configure_mesh()
+            .disable_x_mesh()
+            .y_desc(y_label)
+            .x_labels(bars.len())
+            .x_label_formatter(&|v| match v {
+                SegmentValue::CenterOf(i) => labels.get(*i as usize).cloned().unwrap_or_default(),
+                _ => String::new(),
+            })
+            .draw()
+            .map_err(|e| anyhow!("{e}"))?;
+        chart
+            .draw_series(bars.iter().enumerate().map(|(i, b)| {
+                let i = i as u32;
+                let mut bar = Rectangle::new(
+                    [
+                        (SegmentValue::Exact(i), 0.0),
+                        (SegmentValue::Exact(i + 1), b.1),
+                    ],
+                    COLOURS[0].filled(),
+                );
+                bar.set_margin(0, 0, 12, 12);
+                bar
+            }))
+            .map_err(|e| anyhow!("{e}"))?;
+        root.present().map_err(|e| anyhow!("{e}"))?;
+    }
+    Ok(svg)
+}
