@@ -111,6 +111,28 @@ pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>>
     let ranking = out.join("ranking.md");
     write_atomic(&ranking, ranking_markdown(results).as_bytes())?;
     let mut written = vec![json, md, csv_path, ranking];
+    if !results.designs.is_empty() {
+        let pin = out.join("pin_force.svg");
+        write_atomic(&pin, pin_force_plot(results)?.as_bytes())?;
+        let bars = out.join("peak_force.svg");
+        let peaks: Vec<(String, f64)> = results
+            .designs
+            .iter()
+            .map(|d| (d.mass.id.clone(), d.dynamics.peak_pin_force_n))
+            .collect();
+        write_atomic(
+            &bars,
+            plots::bar_chart(
+                "Peak crank–rod pin force (φ = 40πt, gravity on)",
+                "peak |F_A| [N]",
+                &peaks,
+            )?
+            .as_bytes(),
+        )?;
+        let index = out.join("index.html");
+        write_atomic(&index, index_html(results).as_bytes())?;
+        written.extend([pin, bars, index]);
+    }
     for d in &results.designs {
         let mut w = csv::Writer::from_writer(Vec::new());
         write_history_csv(&mut w, &d.mass.design, &d.history)?;
@@ -119,6 +141,84 @@ pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>>
         written.push(path);
     }
     Ok(written)
+}
+
+/// |F_A| over the first crank revolution, all designs in one plot.
+fn pin_force_plot(results: &StudyResults) -> Result<String> {
+    let series: Vec<plots::Series> = results
+        .designs
+        .iter()
+        .map(|d| {
+            let h = &d.history;
+            let turn = std::f64::consts::TAU;
+            let points = (0..h.t_s.len())
+                .take_while(|&k| h.phi_rad[k] - h.phi_rad[0] <= turn + 1e-9)
+                .map(|k| ((h.phi_rad[k] - h.phi_rad[0]).to_degrees(), h.fa_abs_n[k]))
+                .collect();
+            plots::Series {
+                name: d.mass.design.clone(),
+                points,
+            }
+        })
+        .collect();
+    plots::line_chart(
+        "Crank–rod pin force over one revolution (φ = 40πt, gravity on)",
+        "crank angle φ [°] (0 = top dead centre)",
+        "|F_A| [N]",
+        &series,
+        plots::Scale::Linear,
+        plots::Scale::Linear,
+    )
+}
+
+/// A page that shows the ranking and the plots in a browser.
+fn index_html(results: &StudyResults) -> String {
+    let escape = |s: &str| {
+        s.replace('&', "&amp;")
+            .replace('<', "&lt;")
+            .replace('>', "&gt;")
+    };
+    let mut ranked: Vec<&DesignResult> = results.designs.iter().collect();
+    ranked.sort_by(|a, b| {
+        a.dynamics
+            .peak_pin_force_n
+            .total_cmp(&b.dynamics.peak_pin_force_n)
+    });
+    let mut rows = String::new();
+    for (k, d) in ranked.iter().enumerate() {
+        rows.push_str(&format!(
+            "<tr><td>{}</td><td>{}</td><td>{:.4}</td><td>{:.2}</td><td>{:.5}</td><td>{:.6}</td><td>{:.1}</td><td><a href=\"{}/pin_force.csv\">CSV</a></td></tr>\n",
+            k + 1,
+            escape(&d.mass.design),
+            d.mass.mass_kg,
+            d.mass.l1_m * 1e3,
+            d.mass.i_zz_kgm2,
+            d.mass.i_xx_kgm2,
+            d.dynamics.peak_pin_force_n,
+            file_safe(&d.mass.id)
+        ));
+    }
+    let failed: String = results
+        .failed
+        .iter()
+        .map(|f| {
+            format!(
+                "<li><code>{}</code>: {}</li>\n",
+                escape(&f.file),
+                escape(&f.error)
+            )
+        })
+        .collect();
+    format!(
+        "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>rodstudy report</title>\n<style>body{{font-family:sans-serif;max-width:1000px;margin:2em auto}}table{{border-collapse:collapse}}td,th{{border:1px solid #ccc;padding:4px 8px;text-align:right}}td:nth-child(2){{text-align:left}}img{{max-width:100%}}</style></head><body>\n<h1>Connecting-rod design study</h1>\n<p>Stages run: {}. Not yet available: {}. Ranked by peak crank–rod pin force, lowest first.</p>\n<table><tr><th>rank</th><th>design</th><th>mass [kg]</th><th>l1 [mm]</th><th>I_zz [kg·m²]</th><th>I_xx [kg·m²]</th><th>peak pin force [N]</th><th>history</th></tr>\n{rows}</table>\n{}<h2>Pin force over one revolution</h2><img src=\"pin_force.svg\" alt=\"pin force\">\n<h2>Peak pin force</h2><img src=\"peak_force.svg\" alt=\"peak force\">\n<p>All figures: <a href=\"results.json\">results.json</a>, <a href=\"mass_properties.csv\">mass_properties.csv</a>.</p>\n</body></html>\n",
+        results.stages_run.join(", "),
+        results.stages_not_yet_available.join(", "),
+        if failed.is_empty() {
+            String::new()
+        } else {
+            format!("<h2>Failed designs</h2><ul>{failed}</ul>\n")
+        }
+    )
 }
 
 /// A design name usable as a folder name.
