@@ -137,7 +137,7 @@ def write_deck(path, pts, tets, fixed_nodes, loads, e_mpa, nu):
         for n in np.nonzero(np.abs(f).sum(axis=1))[0]:
             for j in range(3):
                 if f[n, j] != 0.0:
-                    out.append(f"{n + 1}, {j + 1}, {f[n, j]!r}")
+                    out.append(f"{n + 1}, {j + 1}, {float(f[n, j])!r}")
         out += ["*NODE FILE", "U", "*EL FILE", "S", "*END STEP"]
     path.write_text("\n".join(out) + "\n")
 
