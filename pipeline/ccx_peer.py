@@ -124,20 +124,21 @@ def consistent_forces(pts, faces, resultant):
 
 def write_deck(path, pts, tets, fixed_nodes, loads, e_mpa, nu):
     out = ["*HEADING", "rodstudy CalculiX peer (mm, N, MPa)", "*NODE"]
-    out += [f"{i + 1}, {x!r}, {y!r}, {z!r}" for i, (x, y, z) in enumerate(pts.tolist())]
+    # ccx reads at most 20 characters per number: 13 significant digits
+    out += [f"{i + 1}, {x:.13g}, {y:.13g}, {z:.13g}" for i, (x, y, z) in enumerate(pts.tolist())]
     out.append("*ELEMENT, TYPE=C3D10, ELSET=EALL")
     out += [f"{e + 1}, " + ", ".join(str(v + 1) for v in row) for e, row in enumerate(tets.tolist())]
     out.append("*NSET, NSET=FIXED")
     ids = [str(n + 1) for n in fixed_nodes]
     out += [", ".join(ids[i:i + 12]) for i in range(0, len(ids), 12)]
-    out += ["*MATERIAL, NAME=STEEL", "*ELASTIC", f"{e_mpa!r}, {nu!r}",
+    out += ["*MATERIAL, NAME=STEEL", "*ELASTIC", f"{e_mpa:.13g}, {nu:.13g}",
             "*SOLID SECTION, ELSET=EALL, MATERIAL=STEEL", "*BOUNDARY", "FIXED, 1, 3"]
     for k, f in enumerate(loads):
         out += ["*STEP", "*STATIC", "*CLOAD" + (", OP=NEW" if k else "")]
         for n in np.nonzero(np.abs(f).sum(axis=1))[0]:
             for j in range(3):
                 if f[n, j] != 0.0:
-                    out.append(f"{n + 1}, {j + 1}, {float(f[n, j])!r}")
+                    out.append(f"{n + 1}, {j + 1}, {f[n, j]:.13g}")
         out += ["*NODE FILE", "U", "*EL FILE", "S", "*END STEP"]
     path.write_text("\n".join(out) + "\n")
 
