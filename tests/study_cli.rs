@@ -143,3 +143,77 @@ fn dynamics_driven_json_and_csv() {
     let text = std::fs::read_to_string(&csv).unwrap();
     assert!(text.starts_with("design,t_s,phi_rad,fa_x_n,fa_y_n,fa_abs_n"));
 }
+
+#[test]
+fn second_run_uses_the_cache_and_a_changed_design_reruns_alone() {
+    let designs = tempfile::tempdir().unwrap();
+    let out = tempfile::tempdir().unwrap();
+    rod_file(designs.path(), "a.stl");
+    rod_file(designs.path(), "b.stl");
+    let (d, o) = (
+        designs.path().to_str().unwrap(),
+        out.path().to_str().unwrap(),
+    );
+    let first = rodstudy(&["study", "--designs", d, "--out", o]);
+    assert!(String::from_utf8_lossy(&first.stderr).contains("(0 from the cache)"));
+    let second = rodstudy(&["study", "--designs", d, "--out", o]);
+    assert!(String::from_utf8_lossy(&second.stderr).contains("(2 from the cache)"));
+    std::fs::write(designs.path().join("b.toml"), "name = \"B renamed\"\n").unwrap();
+    let third = rodstudy(&["study", "--designs", d, "--out", o]);
+    let log = String::from_utf8_lossy(&third.stderr);
+    assert!(log.contains("(1 from the cache)"), "{log}");
+    assert!(log.contains("a.stl: peak pin force") && log.contains("(cached)"));
+    let results: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.path().join("results.json")).unwrap()).unwrap();
+    assert_eq!(results["designs"][1]["mass"]["design"], "B renamed");
+    // The cached figures are the computed ones.
+    let fresh = rodstudy(&["study", "--designs", d, "--out", o, "--no-cache"]);
+    assert!(String::from_utf8_lossy(&fresh.stderr).contains("(0 from the cache)"));
+    let again: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.path().join("results.json")).unwrap()).unwrap();
+    assert_eq!(results, again);
+}
+
+#[test]
+fn configuration_file_sets_the_scene_and_typos_are_refused() {
+    let designs = tempfile::tempdir().unwrap();
+    let out = tempfile::tempdir().unwrap();
+    rod_file(designs.path(), "rod.stl");
+    let config = designs.path().join("settings.toml");
+    std::fs::write(
+        &config,
+        "[driven]\nomega_rad_s = 62.83185307179586\ngravity = false\n",
+    )
+    .unwrap();
+    let (d, o, c) = (
+        designs.path().to_str().unwrap(),
+        out.path().to_str().unwrap(),
+        config.to_str().unwrap(),
+    );
+    let run = rodstudy(&["study", "--designs", d, "--out", o, "--config", c]);
+    assert_eq!(
+        run.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let results: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.path().join("results.json")).unwrap()).unwrap();
+    assert_eq!(results["config"]["driven"]["gravity"], false);
+    let dynamics = &results["designs"][0]["dynamics"];
+    // Half the thesis' speed: a quarter of the force, exactly the TDC formula without gravity.
+    let peak = dynamics["peak_pin_force_n"].as_f64().unwrap();
+    let formula = dynamics["tdc_formula_n"].as_f64().unwrap();
+    assert!(
+        (peak - formula).abs() < 1e-6 * formula,
+        "{peak} vs {formula}"
+    );
+    std::fs::write(&config, "[driven]\nspeed = 3.0\n").unwrap();
+    let bad = rodstudy(&["study", "--designs", d, "--out", o, "--config", c]);
+    assert_eq!(bad.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&bad.stderr);
+    assert!(
+        e.contains("settings.toml") && e.contains("unknown field `speed`"),
+        "{e}"
+    );
+}

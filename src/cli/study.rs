@@ -1,12 +1,17 @@
-//! `rodstudy study [--designs DIR] [--out DIR]`
+//! `rodstudy study [--designs DIR] [--out DIR] [--config FILE] [--jobs N] [--no-cache]
+//! [--update-baseline]`
 
 use crate::study::atomic_write::write_atomic;
 use crate::study::baseline::{Baseline, read_results};
+use crate::study::config::StudyConfig;
 use crate::study::tables::{dynamics_table, mass_table};
-use crate::study::{run_study, write_reports};
+use crate::study::{Progress, StudyOptions, run_study, write_reports};
 use anyhow::Result;
 use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use std::io::IsTerminal;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 #[derive(Args)]
 pub struct StudyArgs {
@@ -16,18 +21,79 @@ pub struct StudyArgs {
     /// Folder the reports are written to.
     #[arg(long, default_value = "reports")]
     out: PathBuf,
+    /// Settings file (default: `rodstudy.toml` in the current folder if present, else the
+    /// spec's defaults).
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Designs studied at once (default: one per core).
+    #[arg(long, default_value_t = 0)]
+    jobs: usize,
+    /// Recompute every design even when its cached results are current.
+    #[arg(long)]
+    no_cache: bool,
     /// Also write OUT/baseline.json from these results (on purpose: it is what CI checks against).
     #[arg(long)]
     update_baseline: bool,
 }
 
 pub fn run(args: StudyArgs) -> Result<i32> {
-    let results = run_study(&args.designs)?;
+    let config = StudyConfig::load(args.config.as_deref())?;
+    let options = StudyOptions {
+        designs: &args.designs,
+        out: &args.out,
+        config,
+        jobs: args.jobs,
+        use_cache: !args.no_cache,
+    };
+    let count = crate::geometry::design::find_stl_files(std::slice::from_ref(&args.designs))
+        .map(|f| f.len())
+        .unwrap_or(0);
+    // A bar for people at a terminal; plain lines (kept in CI logs) otherwise.
+    let bar = std::io::stderr().is_terminal().then(|| {
+        let bar = ProgressBar::new(count as u64);
+        bar.set_style(
+            ProgressStyle::with_template("{bar:30} {pos}/{len} designs {msg}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        bar
+    });
+    let done = AtomicUsize::new(0);
+    let cached = AtomicUsize::new(0);
+    let on_done = |p: Progress| {
+        let k = done.fetch_add(1, Ordering::SeqCst) + 1;
+        if p.cached {
+            cached.fetch_add(1, Ordering::SeqCst);
+        }
+        let name = p
+            .file
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        match &bar {
+            Some(bar) => {
+                bar.inc(1);
+                bar.set_message(name);
+            }
+            None => match &p.outcome {
+                Ok(d) => eprintln!(
+                    "[{k}/{count}] {name}: peak pin force {:.1} N{}",
+                    d.dynamics.peak_pin_force_n,
+                    if p.cached { " (cached)" } else { "" }
+                ),
+                Err(_) => eprintln!("[{k}/{count}] {name}: FAILED"),
+            },
+        }
+    };
+    let results = run_study(&options, &on_done)?;
+    if let Some(bar) = &bar {
+        bar.finish_and_clear();
+    }
     eprintln!(
-        "study: ran {} on {} design(s) in {}; not yet available: {}",
+        "study: ran {} on {} design(s) in {} ({} from the cache); not yet available: {}",
         results.stages_run.join(", "),
         results.designs.len() + results.failed.len(),
         args.designs.display(),
+        cached.load(Ordering::SeqCst),
         results.stages_not_yet_available.join(", ")
     );
     let designs: Vec<_> = results.designs.iter().map(|d| &d.mass).collect();
@@ -44,9 +110,7 @@ pub fn run(args: StudyArgs) -> Result<i32> {
         eprintln!("FAILED {}", f.error);
     }
     let written = write_reports(&results, &args.out)?;
-    for path in written {
-        eprintln!("wrote {}", path.display());
-    }
+    eprintln!("wrote {} files in {}", written.len(), args.out.display());
     if args.update_baseline {
         if !results.failed.is_empty() {
             anyhow::bail!(

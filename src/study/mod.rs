@@ -6,14 +6,18 @@
 
 pub mod atomic_write;
 pub mod baseline;
+pub mod cache;
+pub mod config;
 pub mod dynamics_stage;
 pub mod plots;
 pub mod tables;
 
 use crate::geometry::design::{DesignMass, find_stl_files, mass_of_design};
-use crate::mechanism::{DrivenResult, DrivenScene, Method};
-use anyhow::{Result, bail};
+use crate::mechanism::{DrivenResult, Method};
+use anyhow::{Context, Result, bail};
 use atomic_write::write_atomic;
+use cache::{Cache, design_key};
+use config::StudyConfig;
 use dynamics_stage::{DesignDynamics, dynamics_of_design, write_history_csv};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -28,6 +32,8 @@ pub const STAGES_NOT_YET_AVAILABLE: &[&str] = &["fem"];
 #[derive(Debug, Clone, Serialize)]
 pub struct StudyResults {
     pub program_version: String,
+    /// The settings used (defaults, `rodstudy.toml` or `--config`).
+    pub config: StudyConfig,
     pub stages_run: Vec<String>,
     pub stages_not_yet_available: Vec<String>,
     pub designs: Vec<DesignResult>,
@@ -51,21 +57,65 @@ pub struct FailedDesign {
     pub error: String,
 }
 
-/// Runs the stages on every `*.stl` of `designs` (in parallel).
-pub fn run_study(designs: &Path) -> Result<StudyResults> {
+/// How a study runs: where, with which settings, how many designs at once.
+pub struct StudyOptions<'a> {
+    pub designs: &'a Path,
+    pub out: &'a Path,
+    pub config: StudyConfig,
+    /// Designs studied at once (rayon threads); 0 = one per core.
+    pub jobs: usize,
+    /// Reuse cached per-design results whose content hash matches.
+    pub use_cache: bool,
+}
+
+/// What happened to one design, reported as soon as it is done (for progress output).
+pub struct Progress<'a> {
+    pub file: &'a Path,
+    pub cached: bool,
+    pub outcome: std::result::Result<&'a DesignResult, String>,
+}
+
+/// The figures of one design that the cache keeps (the history is recomputed: it is cheap).
+#[derive(Serialize, serde::Deserialize)]
+struct CachedDesign {
+    mass: DesignMass,
+    dynamics: DesignDynamics,
+}
+
+/// Runs the stages on every `*.stl` of `options.designs`, designs in parallel, calling
+/// `on_done` as each one finishes.
+pub fn run_study(
+    options: &StudyOptions,
+    on_done: &(dyn Fn(Progress) + Sync),
+) -> Result<StudyResults> {
+    let designs = options.designs;
     if !designs.is_dir() {
         bail!("{}: the designs folder does not exist", designs.display());
     }
     let files = find_stl_files(&[designs.to_path_buf()])?;
-    let outcomes: Vec<(PathBuf, Result<DesignResult>)> = files
-        .into_par_iter()
-        .map(|f| {
-            let r = study_one(&f);
-            (f, r)
-        })
-        .collect();
+    let cache = Cache::new(options.out);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(options.jobs)
+        .build()
+        .context("cannot start the worker threads")?;
+    let outcomes: Vec<(PathBuf, Result<DesignResult>)> = pool.install(|| {
+        files
+            .into_par_iter()
+            .map(|f| {
+                let (r, cached) =
+                    study_one(&f, &options.config, options.use_cache.then_some(&cache));
+                on_done(Progress {
+                    file: &f,
+                    cached,
+                    outcome: r.as_ref().map_err(|e| format!("{e:#}")),
+                });
+                (f, r)
+            })
+            .collect()
+    });
     let mut results = StudyResults {
         program_version: env!("CARGO_PKG_VERSION").into(),
+        config: options.config,
         stages_run: STAGES_RUN.iter().map(|s| s.to_string()).collect(),
         stages_not_yet_available: STAGES_NOT_YET_AVAILABLE
             .iter()
@@ -86,17 +136,54 @@ pub fn run_study(designs: &Path) -> Result<StudyResults> {
     Ok(results)
 }
 
-/// Stage 1 then stage 2 for one design, with the spec's scene (φ = 40πt, 5 s, 5000 steps,
-/// gravity on).
-fn study_one(stl: &Path) -> Result<DesignResult> {
-    let mass = mass_of_design(stl)?;
-    let (dynamics, history) =
-        dynamics_of_design(&mass, &DrivenScene::default(), true, Method::ClosedForm)?;
-    Ok(DesignResult {
-        mass,
-        dynamics,
-        history,
-    })
+/// The stages for one design, from the cache when its content hash matches; the flag says
+/// whether the cache answered.
+fn study_one(
+    stl: &Path,
+    config: &StudyConfig,
+    cache: Option<&Cache>,
+) -> (Result<DesignResult>, bool) {
+    let id = stl
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let key = cache.and_then(|_| design_key(stl, config).ok());
+    let scene = config.driven_scene();
+    if let (Some(cache), Some(key)) = (cache, &key)
+        && let Some(hit) = cache.get::<CachedDesign>(&id, key)
+    {
+        let params = dynamics_stage::mechanism_for(&hit.mass, config.driven.gravity);
+        let rod = dynamics_stage::rod_inertia(&hit.mass);
+        if let Ok(history) =
+            crate::mechanism::driven_scene(&params, &rod, &scene, Method::ClosedForm)
+        {
+            let result = DesignResult {
+                mass: hit.mass,
+                dynamics: hit.dynamics,
+                history,
+            };
+            return (Ok(result), true);
+        }
+    }
+    let computed = (|| {
+        let mass = mass_of_design(stl)?;
+        let (dynamics, history) =
+            dynamics_of_design(&mass, &scene, config.driven.gravity, Method::ClosedForm)?;
+        Ok(DesignResult {
+            mass,
+            dynamics,
+            history,
+        })
+    })();
+    if let (Ok(d), Some(cache), Some(key)) = (&computed, cache, &key) {
+        let entry = CachedDesign {
+            mass: d.mass.clone(),
+            dynamics: d.dynamics.clone(),
+        };
+        // A cache that cannot be written only costs time on the next run.
+        let _ = cache.put(&id, key, &entry);
+    }
+    (computed, false)
 }
 
 /// Writes `results.json`, `mass_properties.md` and `mass_properties.csv` into `out`
@@ -244,7 +331,7 @@ fn ranking_markdown(results: &StudyResults) -> String {
             .total_cmp(&b.dynamics.peak_pin_force_n)
     });
     let mut out = String::from(
-        "# Ranking of the designs\n\nRanked by the peak crank–rod pin force of the driven crank–slider (φ = 40πt, gravity on), lowest first. The stress criterion (FEM stage) is not available yet, so no design is judged on stress.\n\n| rank | design | mass [kg] | l1 [mm] | I_zz [kg·m²] | I_xx [kg·m²] | peak pin force [N] | at crank angle [°] |\n|---|---|---|---|---|---|---|---|\n",
+        "# Ranking of the designs\n\nRanked by the peak crank–rod pin force of the driven crank–slider (scene `driven`; its settings are in `results.json`), lowest first. The stress criterion (FEM stage) is not available yet, so no design is judged on stress.\n\n| rank | design | mass [kg] | l1 [mm] | I_zz [kg·m²] | I_xx [kg·m²] | peak pin force [N] | at crank angle [°] |\n|---|---|---|---|---|---|---|---|\n",
     );
     for (k, d) in ranked.iter().enumerate() {
         out.push_str(&format!(
