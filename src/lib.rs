@@ -6,10 +6,12 @@
 //!   mapping into the mechanism frame;
 //! - [`mechanism`]: stage 2, the planar crank–slider: closed-form Newton–Euler and a planar
 //!   multibody core (thesis §3.2), the driven scene and its peak pin force;
-//! - [`integrators`]: ODE solvers (the thesis' initial-acceleration method, RK45, RK23, BDF,
-//!   Rosenbrock, TR-BDF2) with dense output, step control, counters and caps;
+//! - [`integrators`]: ODE solvers (the thesis' initial-acceleration method, RK45 (optionally
+//!   with projection onto an invariant manifold), RK23, BDF, Rosenbrock, TR-BDF2) and
+//!   generalized-α for constrained mechanical systems, with dense output, step control,
+//!   counters and caps;
 //! - [`free_run`]: scene `free` (thesis ch. 4): the reduction-method equation of motion, its exact
-//!   energy-integral reference and the work–precision sweep;
+//!   energy-integral reference, the multibody DAE forms and the work–precision sweep;
 //! - [`study`]: running the stages over every design of a folder;
 //! - [`python_env`]: the project-local Python environment the `pipeline/` scripts run in;
 //! - [`bench`]: benchmarks, reported as ratios against a reference run;

@@ -6,11 +6,13 @@ use std::fmt;
 use std::str::FromStr;
 
 /// A method for the free-running crank. Names (for `FromStr`/`Display`/serde):
-/// `initial-acceleration`, `rk45`, `rk23`, `bdf`, `rosenbrock`, `trbdf2`.
+/// `initial-acceleration`, `rk45`, `rk23`, `bdf`, `rosenbrock`, `trbdf2`, `dae-index1`,
+/// `dae-genalpha`.
 ///
-/// All current methods integrate the reduced equation of motion (eq. 3.24 / 4.1) and map to
-/// an [`OdeMethod`]; methods on other models (e.g. the multibody DAE forms `dae-index1`,
-/// `dae-genalpha`) are added as further variants returning `None` from [`Method::ode_method`].
+/// The first six ([`Method::REDUCED`]) integrate the reduced equation of motion (eq. 3.24 /
+/// 4.1) and map to an [`OdeMethod`]; the last two ([`Method::DAE`]) integrate the multibody
+/// model of thesis §3.2 as a DAE (see [`super::dae`]) and return `None` from
+/// [`Method::ode_method`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Method {
@@ -27,11 +29,28 @@ pub enum Method {
     /// TR-BDF2 (ode23tb).
     #[serde(rename = "trbdf2")]
     TrBdf2,
+    /// Multibody DAE, stabilised index-1 form (projection by default) with RK45.
+    DaeIndex1,
+    /// Multibody DAE, index-3 form with generalized-α (Arnold & Brüls 2007), fixed step.
+    #[serde(rename = "dae-genalpha")]
+    DaeGenAlpha,
 }
 
 impl Method {
     /// Every method, in table order.
-    pub const ALL: [Method; 6] = [
+    pub const ALL: [Method; 8] = [
+        Method::InitialAcceleration,
+        Method::Rk45,
+        Method::Rk23,
+        Method::Bdf,
+        Method::Rosenbrock,
+        Method::TrBdf2,
+        Method::DaeIndex1,
+        Method::DaeGenAlpha,
+    ];
+
+    /// The methods on the reduced model (eq. 3.24 / 4.1).
+    pub const REDUCED: [Method; 6] = [
         Method::InitialAcceleration,
         Method::Rk45,
         Method::Rk23,
@@ -39,6 +58,9 @@ impl Method {
         Method::Rosenbrock,
         Method::TrBdf2,
     ];
+
+    /// The methods on the multibody DAE (thesis §3.2).
+    pub const DAE: [Method; 2] = [Method::DaeIndex1, Method::DaeGenAlpha];
 
     /// The CLI name.
     pub fn name(self) -> &'static str {
@@ -49,7 +71,14 @@ impl Method {
             Self::Bdf => "bdf",
             Self::Rosenbrock => "rosenbrock",
             Self::TrBdf2 => "trbdf2",
+            Self::DaeIndex1 => "dae-index1",
+            Self::DaeGenAlpha => "dae-genalpha",
         }
+    }
+
+    /// `true` for the multibody DAE forms.
+    pub fn is_dae(self) -> bool {
+        matches!(self, Self::DaeIndex1 | Self::DaeGenAlpha)
     }
 
     /// The generic ODE method integrating the reduced model, if this is one.
@@ -61,17 +90,19 @@ impl Method {
             Self::Bdf => OdeMethod::Bdf,
             Self::Rosenbrock => OdeMethod::Rosenbrock,
             Self::TrBdf2 => OdeMethod::TrBdf2,
+            Self::DaeIndex1 | Self::DaeGenAlpha => return None,
         })
     }
 
-    /// `true` for the fixed-step method (swept over step sizes, not tolerances).
+    /// `true` for the fixed-step methods (swept over step sizes, not tolerances):
+    /// initial-acceleration and dae-genalpha.
     pub fn is_fixed_step(self) -> bool {
-        self.ode_method().is_some_and(OdeMethod::is_fixed_step)
+        self == Self::DaeGenAlpha || self.ode_method().is_some_and(OdeMethod::is_fixed_step)
     }
 
-    /// `true` for the implicit (stiff) methods.
+    /// `true` for the implicit methods (Newton iterations on a Jacobian).
     pub fn is_implicit(self) -> bool {
-        self.ode_method().is_some_and(OdeMethod::is_implicit)
+        self == Self::DaeGenAlpha || self.ode_method().is_some_and(OdeMethod::is_implicit)
     }
 }
 
@@ -84,7 +115,8 @@ impl fmt::Display for Method {
 /// Unknown method name.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error(
-    "unknown method `{0}` (expected one of: initial-acceleration, rk45, rk23, bdf, rosenbrock, trbdf2)"
+    "unknown method `{0}` (expected one of: initial-acceleration, rk45, rk23, bdf, rosenbrock, \
+     trbdf2, dae-index1, dae-genalpha)"
 )]
 pub struct UnknownMethod(pub String);
 
@@ -115,6 +147,17 @@ mod tests {
                 m
             );
         }
+        assert_eq!("dae-index1".parse::<Method>().unwrap(), Method::DaeIndex1);
+        assert_eq!(
+            serde_json::to_string(&Method::DaeGenAlpha).unwrap(),
+            "\"dae-genalpha\""
+        );
+        assert!(
+            Method::DAE
+                .iter()
+                .all(|m| m.is_dae() && m.ode_method().is_none())
+        );
+        assert!(Method::REDUCED.iter().all(|m| !m.is_dae()));
         let e = "ode45".parse::<Method>().unwrap_err();
         assert!(e.to_string().contains("unknown method `ode45`"));
     }

@@ -6,6 +6,11 @@
 //! (eq. 3.22), giving the equation of motion eq. 3.24 / 4.1. Its energy integral gives an
 //! exact reference (`reference`), against which every integrator is measured (`sweep`).
 //!
+//! The same scene also runs through the planar multibody core of thesis §3.2 as a DAE
+//! ([`dae`]: the stabilised index-1 form with RK45, `dae-index1`, and the index-3 form with
+//! generalized-α, `dae-genalpha`); both are measured against the same exact reference, and
+//! report their constraint drift.
+//!
 //! Gravity is off in the `free` scene (see [`Loads::gravity`]) and switchable.
 //!
 //! Tolerance policy: adaptive methods control `atol + rtol·|y_i|` per component; the default
@@ -15,6 +20,7 @@
 //! `max |E(t) − E(t0)|`, `E = ½ I_red φ̇² − M φ − F x + V`, and warns when it exceeds
 //! [`ENERGY_WARN_REL`] of the kinetic energy.
 
+pub mod dae;
 mod loads;
 mod mechanism;
 mod method;
@@ -42,6 +48,7 @@ pub use scene::FreeScene;
 pub use sweep::{SweepConfig, SweepRow, WorkPrecision, work_precision_sweep};
 
 use crate::integrators::SolverError;
+use crate::mechanism::DynamicsError;
 
 /// Failure of a free run or sweep.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -61,4 +68,10 @@ pub enum FreeRunError {
     /// The method does not run on the reduced model.
     #[error("method `{0}` is not available for the reduced model")]
     Unsupported(String),
+    /// The multibody model could not be built or stopped (refused data, singular Jacobian).
+    #[error(transparent)]
+    Multibody(#[from] DynamicsError),
+    /// The scene has a feature the method's model does not have.
+    #[error("scene not supported by this model: {0}")]
+    SceneNotSupported(String),
 }

@@ -2,6 +2,7 @@
 //! hard-case tables: long run, stiff spring, near toggle).
 
 use super::FreeRunError;
+use super::dae::ConstraintViolation;
 use super::method::Method;
 use super::run::{FreeRunOptions, run_free};
 use serde::Serialize;
@@ -33,12 +34,15 @@ pub struct CaseOutcome {
     pub energy_drift_max_j: Option<f64>,
     /// Energy drift relative to the largest kinetic energy.
     pub energy_drift_rel: Option<f64>,
+    /// DAE forms: largest constraint violation on the grid (completed runs).
+    pub constraint_drift_max: Option<ConstraintViolation>,
     /// Warnings of the completed run.
     pub warnings: Vec<String>,
 }
 
-/// Runs each of `methods` with `options`; solver failures become outcomes, other errors
-/// (refused data, bad options) are returned.
+/// Runs each of `methods` with `options`; solver failures and scenes a method's model does
+/// not cover ([`FreeRunError::SceneNotSupported`]) become outcomes, other errors (refused
+/// data, bad options) are returned.
 pub fn run_all(
     methods: &[Method],
     options: &FreeRunOptions,
@@ -59,6 +63,7 @@ pub fn run_all(
                 cpu_s: Some(r.cpu_s),
                 energy_drift_max_j: r.energy_drift_max_j,
                 energy_drift_rel: r.energy_drift_rel,
+                constraint_drift_max: r.constraint_drift_max,
                 warnings: r.warnings,
             },
             Err(FreeRunError::Solver(e)) => CaseOutcome {
@@ -74,6 +79,23 @@ pub fn run_all(
                 cpu_s: None,
                 energy_drift_max_j: None,
                 energy_drift_rel: None,
+                constraint_drift_max: None,
+                warnings: Vec::new(),
+            },
+            Err(FreeRunError::SceneNotSupported(why)) => CaseOutcome {
+                method,
+                completed: false,
+                failure: Some(format!("scene not supported by this model: {why}")),
+                t_reached: options.scene.t0,
+                phi_end_rad: None,
+                omega_end_rad_s: None,
+                steps: 0,
+                rhs_evals: 0,
+                jac_evals: 0,
+                cpu_s: None,
+                energy_drift_max_j: None,
+                energy_drift_rel: None,
+                constraint_drift_max: None,
                 warnings: Vec::new(),
             },
             Err(e) => return Err(e),

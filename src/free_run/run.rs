@@ -1,6 +1,7 @@
 //! One run of one method on a free scene.
 
 use super::FreeRunError;
+use super::dae::{self, ConstraintViolation, DaeOptions};
 use super::method::Method;
 use super::ode::CrankOde;
 use super::scene::FreeScene;
@@ -29,7 +30,7 @@ pub struct FreeRunOptions {
     pub omega_rtol: Option<f64>,
     /// Absolute tolerance of the φ̇ component [rad/s], if different from `atol`.
     pub omega_atol: Option<f64>,
-    /// Step of the fixed-step method \[s\].
+    /// Step of the fixed-step methods (initial-acceleration, dae-genalpha) \[s\].
     pub fixed_step: f64,
     /// Cap on steps.
     pub max_steps: u64,
@@ -37,6 +38,9 @@ pub struct FreeRunOptions {
     pub max_rhs_evals: u64,
     /// Jacobian source of the implicit methods.
     pub jacobian: JacobianSource,
+    /// Settings of the multibody DAE forms (stabilisation, ρ∞, Newton).
+    #[serde(default)]
+    pub dae: DaeOptions,
 }
 
 impl Default for FreeRunOptions {
@@ -51,6 +55,7 @@ impl Default for FreeRunOptions {
             max_steps: 1_000_000,
             max_rhs_evals: 10_000_000,
             jacobian: JacobianSource::Auto,
+            dae: DaeOptions::default(),
         }
     }
 }
@@ -101,6 +106,9 @@ pub struct FreeRunResult {
     pub energy_drift_max_j: Option<f64>,
     /// The drift relative to the largest kinetic energy `½ I_red φ̇²` on the grid.
     pub energy_drift_rel: Option<f64>,
+    /// DAE forms: the largest constraint violation `max |Φ_i|`, `max |(D ċ)_i|` over the
+    /// output grid (rows in m, the slide's angle row in rad); `None` for the reduced model.
+    pub constraint_drift_max: Option<ConstraintViolation>,
     /// Flags raised on an otherwise completed run (e.g. a fixed-step result whose energy
     /// drift exceeds [`ENERGY_WARN_REL`] of the kinetic energy: not trustworthy).
     pub warnings: Vec<String>,
@@ -115,27 +123,43 @@ pub struct FreeRunResult {
 /// Relative energy drift above which a completed run gets a warning.
 pub const ENERGY_WARN_REL: f64 = 1e-3;
 
+/// Constraint drift (m or rad, m/s or rad/s) above which a DAE run gets a warning.
+pub const CONSTRAINT_WARN: f64 = 1e-6;
+
 /// Runs `method` on `options.scene`: builds and checks the model (refusing `l ≤ r` and
 /// `I_red ≤ 0` before integrating), integrates the reduced equation of motion (eq. 3.24 / 4.1)
-/// and evaluates the energy drift.
+/// or, for [`Method::DAE`], the multibody DAE ([`dae`]), and evaluates the energy drift (with
+/// the reduced model's energy of the crank's φ, φ̇, for every method) and, for the DAE forms,
+/// the constraint drift.
 pub fn run_free(method: Method, options: &FreeRunOptions) -> Result<FreeRunResult, FreeRunError> {
     let scene = &options.scene;
     let model = scene.model()?;
     let grid = scene.grid()?;
-    let Some(ode_method) = method.ode_method() else {
-        return Err(FreeRunError::Unsupported(method.to_string()));
+    let run = match method.ode_method() {
+        Some(ode_method) => {
+            let sys = CrankOde {
+                model: &model,
+                loads: scene.loads,
+            };
+            let y0 = DVector::from_vec(vec![scene.phi0, scene.omega0]);
+            let opts = options.solver_options(method);
+            let start = Instant::now();
+            let sol = solve(ode_method, &sys, &y0, &grid, &opts)?;
+            let cpu_s = start.elapsed().as_secs_f64();
+            dae::DaeRun {
+                phi: sol.component(0),
+                omega: sol.component(1),
+                t: sol.t,
+                stats: sol.stats,
+                cpu_s,
+                drift: ConstraintViolation::default(),
+                model: "reduced (thesis eq. 3.24, two-mass rod)",
+            }
+        }
+        None => dae::run(method, options, &grid)?,
     };
-    let sys = CrankOde {
-        model: &model,
-        loads: scene.loads,
-    };
-    let y0 = DVector::from_vec(vec![scene.phi0, scene.omega0]);
-    let opts = options.solver_options(method);
-    let start = Instant::now();
-    let sol = solve(ode_method, &sys, &y0, &grid, &opts)?;
-    let cpu_s = start.elapsed().as_secs_f64();
-    let phi = sol.component(0);
-    let omega = sol.component(1);
+    let constraint_drift_max = method.is_dae().then_some(run.drift);
+    let (phi, omega) = (run.phi, run.omega);
     let (energy_drift_max_j, energy_drift_rel) = if scene.loads.is_conservative() {
         let e0 = model.energy(&scene.loads, phi[0], omega[0]);
         let (mut drift, mut ke_max) = (0.0f64, 0.0f64);
@@ -158,21 +182,31 @@ pub fn run_free(method: Method, options: &FreeRunOptions) -> Result<FreeRunResul
             if method.is_fixed_step() { " (fixed step too large)" } else { " (tolerance too loose)" }
         ));
     }
+    if let Some(d) = constraint_drift_max
+        && (d.position > CONSTRAINT_WARN || d.velocity > CONSTRAINT_WARN)
+    {
+        warnings.push(format!(
+            "constraint drift max |Φ| = {:.3e}, max |D ċ| = {:.3e} (> {CONSTRAINT_WARN:e}): the \
+             mechanism has come apart by that much",
+            d.position, d.velocity
+        ));
+    }
     Ok(FreeRunResult {
         method,
-        model: "reduced (thesis eq. 3.24, two-mass rod)",
+        model: run.model,
         phi_rad: *phi.last().unwrap_or(&f64::NAN),
         omega_rad_s: *omega.last().unwrap_or(&f64::NAN),
-        steps: sol.stats.steps,
-        rejected_steps: sol.stats.rejected_steps,
-        rhs_evals: sol.stats.rhs_evals,
-        jac_evals: sol.stats.jac_evals,
-        lu_decompositions: sol.stats.lu_decompositions,
-        cpu_s,
+        steps: run.stats.steps,
+        rejected_steps: run.stats.rejected_steps,
+        rhs_evals: run.stats.rhs_evals,
+        jac_evals: run.stats.jac_evals,
+        lu_decompositions: run.stats.lu_decompositions,
+        cpu_s: run.cpu_s,
         energy_drift_max_j,
         energy_drift_rel,
+        constraint_drift_max,
         warnings,
-        t: sol.t,
+        t: run.t,
         phi,
         omega,
     })

@@ -1,6 +1,7 @@
 //! Work–precision sweep of the `free` scene against the exact reference.
 
 use super::FreeRunError;
+use super::dae::{ConstraintViolation, DaeOptions};
 use super::method::Method;
 use super::run::{FreeRunOptions, run_free};
 use super::scene::FreeScene;
@@ -12,16 +13,23 @@ use std::time::Instant;
 /// What to sweep.
 ///
 /// Adaptive methods run with purely absolute error control, `rtol = 0`, `atol = tol` on both
-/// components (φ \[rad\], φ̇ [rad/s]); the fixed-step method runs with each step in
-/// `fixed_steps`. CPU time is the median of `repeats` runs.
+/// components (φ \[rad\], φ̇ [rad/s]; dae-index1: on all 18 coordinates and velocities); the
+/// initial-acceleration method runs with each step in `fixed_steps`, dae-genalpha with each
+/// step in `genalpha_steps`. CPU time is the median of `repeats` runs.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SweepConfig {
     /// Methods, in table order.
     pub methods: Vec<Method>,
     /// Absolute tolerances for the adaptive methods, loosest first.
     pub tolerances: Vec<f64>,
-    /// Steps \[s\] for the fixed-step method, largest first.
+    /// Steps \[s\] for the initial-acceleration method, largest first.
     pub fixed_steps: Vec<f64>,
+    /// Steps \[s\] for dae-genalpha, largest first.
+    #[serde(default = "default_genalpha_steps")]
+    pub genalpha_steps: Vec<f64>,
+    /// Settings of the DAE forms.
+    #[serde(default)]
+    pub dae: DaeOptions,
     /// Repeats per point (CPU time is their median).
     pub repeats: usize,
     /// Cap on steps per run.
@@ -38,12 +46,18 @@ impl Default for SweepConfig {
             methods: Method::ALL.to_vec(),
             tolerances: vec![1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12],
             fixed_steps: vec![1e-3, 1e-4, 1e-5, 1e-6],
+            genalpha_steps: default_genalpha_steps(),
+            dae: DaeOptions::default(),
             repeats: 5,
             max_steps: 1_000_000,
             max_rhs_evals: 10_000_000,
             jacobian: JacobianSource::Auto,
         }
     }
+}
+
+fn default_genalpha_steps() -> Vec<f64> {
+    vec![1e-3, 3e-4, 1e-4, 3e-5, 1e-5]
 }
 
 /// One point of the work–precision table.
@@ -73,6 +87,8 @@ pub struct SweepRow {
     pub cpu_s: f64,
     /// Energy drift `max |E − E0|` \[J\].
     pub energy_drift_max_j: Option<f64>,
+    /// DAE forms: largest constraint violation on the grid.
+    pub constraint_drift_max: Option<ConstraintViolation>,
 }
 
 /// The sweep's result.
@@ -158,7 +174,9 @@ pub fn work_precision_sweep(
     let reference_cpu_s = start.elapsed().as_secs_f64();
     let mut rows = Vec::new();
     for &method in &cfg.methods {
-        let (setting, values) = if method.is_fixed_step() {
+        let (setting, values) = if method == Method::DaeGenAlpha {
+            ("step", &cfg.genalpha_steps)
+        } else if method.is_fixed_step() {
             ("step", &cfg.fixed_steps)
         } else {
             ("atol", &cfg.tolerances)
@@ -174,6 +192,7 @@ pub fn work_precision_sweep(
                 max_steps: cfg.max_steps,
                 max_rhs_evals: cfg.max_rhs_evals,
                 jacobian: cfg.jacobian,
+                dae: cfg.dae,
             };
             let mut times = Vec::with_capacity(cfg.repeats.max(1));
             let mut last = None;
@@ -208,6 +227,7 @@ pub fn work_precision_sweep(
                         lu_decompositions: r.lu_decompositions,
                         cpu_s,
                         energy_drift_max_j: r.energy_drift_max_j,
+                        constraint_drift_max: r.constraint_drift_max,
                     }
                 }
                 Some(Err(e)) => SweepRow {
@@ -223,6 +243,7 @@ pub fn work_precision_sweep(
                     lu_decompositions: e.stats.lu_decompositions,
                     cpu_s,
                     energy_drift_max_j: None,
+                    constraint_drift_max: None,
                 },
                 None => unreachable!("at least one repeat"),
             });
@@ -231,7 +252,8 @@ pub fn work_precision_sweep(
     Ok(WorkPrecision {
         scene: *scene,
         tolerance_policy: "adaptive methods: rtol = 0, atol = tol on φ [rad] and φ̇ [rad/s] \
-                           (weighted RMS norm); initial-acceleration: fixed step",
+                           (weighted RMS norm; dae-index1: on all 9 coordinates and 9 \
+                           velocities); initial-acceleration and dae-genalpha: fixed step",
         reference_panels: reference.panels,
         reference_cpu_s,
         rows,

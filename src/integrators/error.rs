@@ -26,6 +26,17 @@ pub enum FailureKind {
     NonFinite,
     /// Inconsistent input (dimensions, tolerances, step size, interval).
     InvalidInput(String),
+    /// A Newton iteration of a fixed-step implicit method did not converge within its cap.
+    NoConvergence {
+        /// Iterations spent on the step.
+        iterations: usize,
+        /// Scaled size of the last Newton increment (1 = the convergence tolerance).
+        increment: f64,
+    },
+    /// An iteration matrix was singular (e.g. a mechanism at a toggle position).
+    SingularMatrix,
+    /// A post-step projection onto an invariant manifold failed (with its reason).
+    Projection(String),
 }
 
 impl fmt::Display for FailureKind {
@@ -41,6 +52,18 @@ impl fmt::Display for FailureKind {
             Self::StepSizeUnderflow { h } => write!(f, "step size underflow (h = {h:e} s)"),
             Self::NonFinite => write!(f, "non-finite state or derivative (solution blew up)"),
             Self::InvalidInput(msg) => write!(f, "invalid input: {msg}"),
+            Self::NoConvergence {
+                iterations,
+                increment,
+            } => write!(
+                f,
+                "Newton iteration did not converge in {iterations} iterations (last increment \
+                 {increment:.2e} × tolerance)"
+            ),
+            Self::SingularMatrix => write!(f, "singular iteration matrix"),
+            Self::Projection(msg) => {
+                write!(f, "projection onto the invariant manifold failed: {msg}")
+            }
         }
     }
 }

@@ -20,12 +20,17 @@
 //! - [`initial_acceleration`]: the thesis' "initial acceleration" method (§4.1.1, eq. 4.5–4.13),
 //!   fixed step, for second-order systems in the layout `y = [q; q̇]`;
 //! - [`rk45`]: Dormand & Prince (1980) 5(4) with its 4th-order continuous extension (ode45);
+//!   [`rk45::solve_projected`] adds a post-step projection onto an invariant manifold
+//!   ([`StepProjection`]), used for the stabilised index-1 multibody form;
 //! - [`rk23`]: Bogacki & Shampine (1989) 3(2), cubic Hermite dense output (ode23);
 //! - [`bdf`]: variable-order (1–5) BDF in backward-difference form with quasi-constant step
 //!   (Shampine & Reichelt 1997, ode15s; Byrne & Hindmarsh 1975); the NDF variant of ode15s is
 //!   [`OdeMethod::Ndf`];
 //! - [`rosenbrock`]: the Shampine & Reichelt (1997) modified Rosenbrock 2(3) W-method (ode23s);
-//! - [`trbdf2`]: TR-BDF2 with the Hosea & Shampine (1996) embedded estimate (ode23tb).
+//! - [`trbdf2`]: TR-BDF2 with the Hosea & Shampine (1996) embedded estimate (ode23tb);
+//! - [`genalpha`]: generalized-α (Chung & Hulbert 1993) for constrained mechanical systems in
+//!   index-3 form (Arnold & Brüls 2007), fixed step, Newton on positions and multipliers; it
+//!   integrates a [`genalpha::ConstrainedSystem`], not an [`OdeSystem`].
 //!
 //! Why hand-written and not `diffsol` 0.18: measured on the 2-state crank problem (same
 //! tolerances, same 1e-4 s output grid), diffsol's BDF was as fast as [`bdf`], its TR-BDF2
@@ -43,12 +48,14 @@ mod lu;
 mod newton;
 mod norm;
 mod options;
+mod projection;
 mod stats;
 mod system;
 #[cfg(test)]
 mod tests_common;
 
 pub mod bdf;
+pub mod genalpha;
 pub mod initial_acceleration;
 mod method;
 pub mod rk23;
@@ -61,5 +68,6 @@ pub use grid::{OutputGrid, Solution};
 pub use method::{OdeMethod, solve};
 pub use norm::rms_norm_scaled;
 pub use options::{JacobianSource, SolverOptions};
+pub use projection::StepProjection;
 pub use stats::Stats;
 pub use system::OdeSystem;

@@ -7,13 +7,26 @@
 //! `0.9 err^(-1/5)` in `[0.2, 5]` (no increase right after a rejection).
 //! Dense output: the 4th-order continuous extension of MATLAB's `ntrp45`
 //! (Shampine 1986; `y(t+θh) = y + h Σ_i k_i Σ_j BI_ij θ^j`).
+//!
+//! With a post-step projection ([`solve_projected`], Hairer, Lubich & Wanner, *Geometric
+//! Numerical Integration*, §IV.4) each accepted step is: the Dormand–Prince step from the
+//! projected `y_n` gives `ỹ_{n+1}` (error test on `ỹ_{n+1}`), then `y_{n+1} = P(ỹ_{n+1})`, and
+//! the FSAL stage is re-evaluated at `y_{n+1}` (one extra evaluation per step) so that the next
+//! step starts consistently. Dense output stays consistent with the projected solution: the
+//! step's continuous extension (built from `y_n` and the step's own stages, so it ends at
+//! `ỹ_{n+1}`) is evaluated at each interior output time and the sample is projected with the
+//! same map `P`; a grid point at `t_{n+1}` takes `y_{n+1}`. The samples therefore lie on the
+//! manifold, and differ from the unprojected interpolant by O(local error), which keeps its
+//! 4th order.
 
 use super::control::{check_underflow, clamp_to_end, factor, initial_step, max_step};
 use super::eval::Evaluator;
 use super::grid::Recorder;
 use super::method::{check_input, invalid};
 use super::norm::{Weights, all_finite};
-use super::{OdeSystem, OutputGrid, Solution, SolverError, SolverOptions};
+use super::{
+    FailureKind, OdeSystem, OutputGrid, Solution, SolverError, SolverOptions, StepProjection,
+};
 use nalgebra::DVector;
 
 const NAME: &str = "rk45";
@@ -77,12 +90,43 @@ pub fn solve<S: OdeSystem + ?Sized>(
     grid: &OutputGrid,
     opts: &SolverOptions,
 ) -> Result<Solution, SolverError> {
+    integrate(sys, y0, grid, opts, None)
+}
+
+/// [`solve`] with a projection onto an invariant manifold after every accepted step, applied
+/// to `y0` and to every dense-output sample as well (see the module docs). A failed projection
+/// stops the run with [`FailureKind::Projection`].
+pub fn solve_projected<S: OdeSystem + ?Sized>(
+    sys: &S,
+    y0: &DVector<f64>,
+    grid: &OutputGrid,
+    opts: &SolverOptions,
+    projection: &mut dyn StepProjection,
+) -> Result<Solution, SolverError> {
+    integrate(sys, y0, grid, opts, Some(projection))
+}
+
+fn integrate<S: OdeSystem + ?Sized>(
+    sys: &S,
+    y0: &DVector<f64>,
+    grid: &OutputGrid,
+    opts: &SolverOptions,
+    mut proj: Option<&mut dyn StepProjection>,
+) -> Result<Solution, SolverError> {
     let (t0, t_end) = (grid.t0, grid.t_end());
     check_input(sys, y0, opts).map_err(|m| invalid(NAME, t0, m))?;
     let n = y0.len();
     let weights = Weights::new(opts, n);
     let mut ev = Evaluator::new(sys, NAME, opts, t0);
+    let mut y0 = y0.clone();
+    if let Some(p) = proj.as_deref_mut() {
+        p.project(t0, &mut y0)
+            .map_err(|m| ev.fail(FailureKind::Projection(m)))?;
+    }
+    let y0 = &y0;
     let mut rec = Recorder::new(grid, y0);
+    let mut y_proj = DVector::zeros(n);
+    let mut proj_failure = None;
     let h_max = max_step(opts, t_end - t0);
     let mut k: [DVector<f64>; 7] = std::array::from_fn(|_| DVector::zeros(n));
     let mut y = y0.clone();
@@ -131,7 +175,13 @@ pub fn solve<S: OdeSystem + ?Sized>(
             rejected_last = true;
             continue;
         }
-        rec.record(t, t_new, &y_new, |theta, out| {
+        if let Some(p) = proj.as_deref_mut() {
+            y_proj.copy_from(&y_new);
+            p.project(t_new, &mut y_proj)
+                .map_err(|m| ev.fail(FailureKind::Projection(m)))?;
+        }
+        let y_out = if proj.is_some() { &y_proj } else { &y_new };
+        rec.record(t, t_new, y_out, |theta, out| {
             let (t1, t2, t3, t4) = (theta, theta * theta, theta.powi(3), theta.powi(4));
             out.copy_from(&y);
             for (j, kj) in k.iter().enumerate() {
@@ -140,10 +190,23 @@ pub fn solve<S: OdeSystem + ?Sized>(
                     out.axpy(h_step * b, kj, 1.0);
                 }
             }
+            if let Some(p) = proj.as_deref_mut()
+                && let Err(m) = p.project(t + theta * h_step, out)
+            {
+                proj_failure.get_or_insert(m);
+            }
         });
+        if let Some(m) = proj_failure.take() {
+            return Err(ev.fail(FailureKind::Projection(m)));
+        }
         ev.accept_step(t_new);
         if last {
             break;
+        }
+        if proj.is_some() {
+            // the FSAL stage belongs to the unprojected ỹ_{n+1}: re-evaluate at y_{n+1}
+            y_new.copy_from(&y_proj);
+            ev.rhs_finite(t_new, &y_new, &mut k[6])?;
         }
         let fac_max = if rejected_last { 1.0 } else { 5.0 };
         h = (h_step * factor(en, 5.0, 0.9, 0.2, fac_max)).min(h_max);
@@ -210,6 +273,71 @@ mod tests {
         // steps grow like tol^(-1/5): 1000^(1/5) ≈ 4
         let ratio = n2 / n1;
         assert!(ratio > 3.0 && ratio < 5.5, "step ratio {ratio}");
+    }
+
+    /// Radial projection onto the oscillator's energy ellipse q² + (q̇/ω)² = 1.
+    struct OntoEllipse {
+        omega: f64,
+        calls: usize,
+    }
+
+    impl StepProjection for OntoEllipse {
+        fn project(&mut self, _t: f64, y: &mut DVector<f64>) -> Result<(), String> {
+            self.calls += 1;
+            let r = (y[0] * y[0] + (y[1] / self.omega).powi(2)).sqrt();
+            if r == 0.0 {
+                return Err("at the origin".into());
+            }
+            *y /= r;
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn projection_keeps_the_invariant_and_the_accuracy() {
+        let sys = Oscillator { omega: 2.0 };
+        let grid = OutputGrid::new(0.0, 20.0, 0.05).unwrap();
+        let y0 = DVector::from_vec(vec![1.0, 0.0]);
+        let opts = SolverOptions::absolute(1e-6);
+        let invariant = |s: &Solution| {
+            (0..s.t.len())
+                .map(|k| (s.y_at(k)[0].powi(2) + (s.y_at(k)[1] / 2.0).powi(2) - 1.0).abs())
+                .fold(0.0, f64::max)
+        };
+        let plain = solve(&sys, &y0, &grid, &opts).unwrap();
+        let mut p = OntoEllipse {
+            omega: 2.0,
+            calls: 0,
+        };
+        let proj = solve_projected(&sys, &y0, &grid, &opts, &mut p).unwrap();
+        assert!(invariant(&plain) > 1e-7, "{:e}", invariant(&plain));
+        assert!(invariant(&proj) < 1e-15, "{:e}", invariant(&proj));
+        // every step and every interior sample was projected; one extra evaluation per step
+        assert!(p.calls as u64 >= proj.stats.steps + grid.n as u64 / 2);
+        assert!(proj.stats.rhs_evals >= 6 * proj.stats.steps + proj.stats.steps - 1);
+        let e_plain = max_error(&plain, |t| sys.exact(t).to_vec());
+        let e_proj = max_error(&proj, |t| sys.exact(t).to_vec());
+        assert!(
+            e_proj < 2.0 * e_plain && e_proj < 1e-5,
+            "{e_proj:e} vs {e_plain:e}"
+        );
+        // a failing projection is a typed error
+        let mut bad = OntoEllipse {
+            omega: 2.0,
+            calls: 0,
+        };
+        let e = solve_projected(
+            &sys,
+            &DVector::from_vec(vec![0.0, 0.0]),
+            &grid,
+            &opts,
+            &mut bad,
+        )
+        .unwrap_err();
+        assert!(
+            matches!(e.kind, FailureKind::Projection(ref m) if m == "at the origin"),
+            "{e}"
+        );
     }
 
     #[test]

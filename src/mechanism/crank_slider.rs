@@ -259,7 +259,8 @@ pub mod joints {
     pub const B: usize = 2;
     /// Translational ground–piston along x (λ = [couple, normal force] on the piston).
     pub const SLIDE: usize = 3;
-    /// Driving constraint φ₂ = φ(t) (λ = driving torque on the crank).
+    /// Driving constraint φ₂ = φ(t) (λ = driving torque on the crank); absent
+    /// from [`CrankSlider::free_multibody`](super::CrankSlider::free_multibody).
     pub const DRIVE: usize = 4;
 }
 
@@ -313,6 +314,33 @@ impl CrankSlider {
         motion: CrankMotion,
         options: SolverOptions,
     ) -> Result<MultibodySystem<9>> {
+        let mut b = self.joints_and_loads(options);
+        b.add_driving("crank drive", BodyId::Ground, BodyId::Moving(0), motion);
+        b.build::<9>()
+    }
+
+    /// The free crank–slider (thesis eq. 3.25–3.26: the same 9 coordinates,
+    /// joints O, A, B and the slide, **no driver**: 8 equations, one degree of
+    /// freedom) for forward dynamics ([`forward`](super::forward)), loaded by
+    /// a constant torque on the crank (N·m, positive counter-clockwise),
+    /// besides the piston force and gravity of the parameters.
+    pub fn free_multibody(
+        &self,
+        crank_torque_nm: f64,
+        options: SolverOptions,
+    ) -> Result<MultibodySystem<9>> {
+        let mut b = self.joints_and_loads(options);
+        if crank_torque_nm != 0.0 {
+            b.add_load(AppliedLoad::Torque {
+                body: BodyId::Moving(0),
+                torque_nm: crank_torque_nm,
+            });
+        }
+        b.build_with_dof::<9>()
+    }
+
+    /// Bodies, joints O, A, B, slide, gravity and the piston force.
+    fn joints_and_loads(&self, options: SolverOptions) -> MultibodyBuilder {
         let p = &self.params;
         let (r, l, e) = (
             p.crank_radius_m,
@@ -354,7 +382,6 @@ impl CrankSlider {
             Vector2::zeros(),
             0.0,
         )
-        .add_driving("crank drive", BodyId::Ground, crank, motion)
         .gravity(p.gravity_vector())
         .options(options);
         if p.piston_force_n != 0.0 {
@@ -364,7 +391,7 @@ impl CrankSlider {
                 force: Vector2::new(p.piston_force_n, 0.0),
             });
         }
-        b.build::<9>()
+        b
     }
 
     /// A rough assembly guess for the multibody model at crank angle φ₀: the

@@ -21,7 +21,8 @@
 //! | `translational.rs` | translational joint, eq. 2.28–2.29 |
 //! | `driving.rs` | driving constraint φⱼ − φᵢ = f(t) |
 //! | `lu.rs` | nalgebra's fixed-size LU (partial) and `FullPivLU` (rank-revealing) behind one interface, plus what nalgebra lacks: relative pivot, transposed solve, dependent-row diagnosis |
-//! | `system.rs` | [`MultibodySystem`]: assembly of Φ, D, γ, M, h; Newton–Raphson position analysis, velocity, acceleration, Lagrange multipliers, joint reactions; [`Tracker`] along the motion |
+//! | `system.rs` | [`MultibodySystem`]: assembly of Φ, D, γ, M, h; Newton–Raphson position analysis, velocity, acceleration, Lagrange multipliers, joint reactions; [`Tracker`] along the motion; `build_with_dof` for systems that keep degrees of freedom |
+//! | `forward.rs` | forward dynamics of such systems: the index-1 form [M −Dᵀ; D 0][c̈; λ] = [h; γ̃] (plain or Baumgarte), constraint violation, projection onto Φ = 0, D ċ = ν |
 //! | `crank_slider.rs` | [`RodInertia`], [`MechanismParams`] (spec defaults, builder, validation), [`CrankSlider`] (validated model, its multibody form), [`PinLoads`] |
 //! | `closed_form.rs` | closed-form kinematics (eq. 2.1–2.12) and hand-solved Newton–Euler loads: the oracle |
 //! | `peak.rs` | the true maximum of \|F_A\| (scan + golden section on the closed form) |
@@ -42,7 +43,10 @@
 //!   multipliers give the reaction D_{k,b}ᵀλ_k on each of its bodies; for a
 //!   revolute joint between bodies i and j, λ is the force of i on j.
 //! * The ground is implicit (no coordinates); the crank–slider has 9 body
-//!   coordinates (crank, rod, piston) and 9 constraint equations.
+//!   coordinates (crank, rod, piston) and 9 constraint equations; without the
+//!   driver ([`CrankSlider::free_multibody`], thesis eq. 3.25) 8 equations and
+//!   one degree of freedom, for forward dynamics ([`forward`]; the `free`
+//!   scene's DAE forms in [`crate::free_run::dae`]).
 //! * Default method for the study: [`Method::ClosedForm`] (cheapest exact
 //!   model); the multibody core is the cross-check run by the tests over full
 //!   scenes. Neither integrates in time: the driven mechanism has zero DOF.
@@ -53,6 +57,7 @@ pub mod constraint;
 pub mod crank_slider;
 pub mod driving;
 pub mod error;
+pub mod forward;
 pub mod lu;
 pub mod motion;
 pub mod peak;
@@ -69,6 +74,7 @@ pub use crank_slider::{
     CrankSlider, MechanismParams, MechanismParamsBuilder, PinLoads, RodInertia,
 };
 pub use error::{DynamicsError, Result};
+pub use forward::{Baumgarte, ConstraintViolation, ForwardSolution};
 pub use motion::{CrankMotion, MotionSample};
 pub use peak::{PeakRefinement, refine_peak, wrap_degrees};
 pub use scene::{Agreement, DrivenResult, DrivenScene, Method, compare_results, driven_scene};

@@ -256,6 +256,20 @@ impl MultibodyBuilder {
     /// Validate and freeze. `N` must be 3 × (number of moving bodies) and the
     /// joints must give exactly `N` equations (zero DOF).
     pub fn build<const N: usize>(&self) -> Result<MultibodySystem<N>> {
+        self.build_checked(false)
+    }
+
+    /// Validate and freeze a system that keeps degrees of freedom: the joints
+    /// give m ≤ `N` equations (rows 0..m of Φ, D, γ; the remaining N − m rows
+    /// are identically zero and carry no multiplier). Such a system is for
+    /// forward dynamics ([`forward`](super::forward)); its kinematic analysis
+    /// ([`MultibodySystem::analyze`]) is refused with
+    /// [`DynamicsError::ConstraintCount`].
+    pub fn build_with_dof<const N: usize>(&self) -> Result<MultibodySystem<N>> {
+        self.build_checked(true)
+    }
+
+    fn build_checked<const N: usize>(&self, allow_dof: bool) -> Result<MultibodySystem<N>> {
         let nb = self.bodies.len();
         if nb == 0 || 3 * nb != N {
             return Err(DynamicsError::InvalidModel(format!(
@@ -344,7 +358,7 @@ impl MultibodyBuilder {
             });
             row += m;
         }
-        if row < N {
+        if row < N && !allow_dof {
             return Err(DynamicsError::ConstraintCount {
                 equations: row,
                 coordinates: N,
@@ -395,6 +409,7 @@ impl MultibodyBuilder {
             mass[3 * k + 2] = b.inertia_kgm2;
         }
         Ok(MultibodySystem {
+            equations: row,
             bodies: self.bodies.clone(),
             joints,
             loads: self.loads.clone(),
@@ -468,15 +483,19 @@ pub struct JointReaction {
 /// A built, validated planar multibody system with `N` body coordinates.
 #[derive(Clone, Debug)]
 pub struct MultibodySystem<const N: usize> {
+    /// Number m of constraint equations (rows 0..m); `N` for a zero-DOF system.
+    pub(super) equations: usize,
     bodies: Vec<Body>,
     joints: Vec<NamedJoint>,
     loads: Vec<AppliedLoad>,
     gravity: Vector2<f64>,
     options: SolverOptions,
-    length_scale: f64,
-    row_scale: SVector<f64, N>,
-    col_scale: SVector<f64, N>,
-    mass: SVector<f64, N>,
+    pub(super) length_scale: f64,
+    /// R: 1 for length rows, L for angle rows (module docs, "Scaling").
+    pub(super) row_scale: SVector<f64, N>,
+    /// C: 1 for x, y columns, 1/L for φ columns.
+    pub(super) col_scale: SVector<f64, N>,
+    pub(super) mass: SVector<f64, N>,
 }
 
 type Poses<const N: usize> = [Pose; N];
@@ -517,6 +536,16 @@ where
         self.joints.iter().position(|j| j.name == name)
     }
 
+    /// Number m of constraint equations (rows 0..m of Φ, D, γ, λ).
+    pub fn equations(&self) -> usize {
+        self.equations
+    }
+
+    /// Degrees of freedom N − m (0 for a fully driven system).
+    pub fn dof(&self) -> usize {
+        N - self.equations
+    }
+
     /// The characteristic length L used for scaling (m).
     pub fn length_scale(&self) -> f64 {
         self.length_scale
@@ -532,7 +561,7 @@ where
         self.mass
     }
 
-    fn poses(&self, q: &SVector<f64, N>) -> Poses<N> {
+    pub(super) fn poses(&self, q: &SVector<f64, N>) -> Poses<N> {
         let mut p = [Pose::GROUND; N];
         for (k, slot) in p.iter_mut().take(self.bodies.len()).enumerate() {
             *slot = Pose::new(q[3 * k], q[3 * k + 1], q[3 * k + 2]);
@@ -540,7 +569,7 @@ where
         p
     }
 
-    fn twists(&self, qd: &SVector<f64, N>) -> Twists<N> {
+    pub(super) fn twists(&self, qd: &SVector<f64, N>) -> Twists<N> {
         let mut v = [Twist::ZERO; N];
         for (k, slot) in v.iter_mut().take(self.bodies.len()).enumerate() {
             *slot = Twist {
@@ -551,7 +580,7 @@ where
         v
     }
 
-    fn eval_phi(&self, p: &Poses<N>, t: f64) -> SVector<f64, N> {
+    pub(super) fn eval_phi(&self, p: &Poses<N>, t: f64) -> SVector<f64, N> {
         let mut out = SVector::<f64, N>::zeros();
         for nj in &self.joints {
             let (bi, bj) = nj.joint.bodies();
@@ -568,7 +597,12 @@ where
     }
 
     /// D, or the scaled S = R D C when `scaled` (see the module docs).
-    fn assemble_jacobian(&self, p: &Poses<N>, t: f64, scaled: bool) -> SMatrix<f64, N, N> {
+    pub(super) fn assemble_jacobian(
+        &self,
+        p: &Poses<N>,
+        t: f64,
+        scaled: bool,
+    ) -> SMatrix<f64, N, N> {
         let mut d = SMatrix::<f64, N, N>::zeros();
         for nj in &self.joints {
             let (bi, bj) = nj.joint.bodies();
@@ -589,7 +623,7 @@ where
         d
     }
 
-    fn eval_nu(&self, t: f64) -> SVector<f64, N> {
+    pub(super) fn eval_nu(&self, t: f64) -> SVector<f64, N> {
         let mut out = SVector::<f64, N>::zeros();
         for nj in &self.joints {
             let f = nj.joint.nu(t);
@@ -600,7 +634,7 @@ where
         out
     }
 
-    fn eval_gamma(&self, p: &Poses<N>, v: &Twists<N>, t: f64) -> SVector<f64, N> {
+    pub(super) fn eval_gamma(&self, p: &Poses<N>, v: &Twists<N>, t: f64) -> SVector<f64, N> {
         let mut out = SVector::<f64, N>::zeros();
         for nj in &self.joints {
             let (bi, bj) = nj.joint.bodies();
@@ -618,7 +652,7 @@ where
         out
     }
 
-    fn eval_h(&self, p: &Poses<N>) -> SVector<f64, N> {
+    pub(super) fn eval_h(&self, p: &Poses<N>) -> SVector<f64, N> {
         let mut h = SVector::<f64, N>::zeros();
         for (k, b) in self.bodies.iter().enumerate() {
             h[3 * k] = b.mass_kg * self.gravity.x;
@@ -728,6 +762,10 @@ where
     /// Rank diagnosis of D at a configuration: `Err(SingularJacobian)` naming
     /// the dependent joint, or the relative pivot.
     pub fn check_jacobian(&self, q: &SVector<f64, N>, t: f64) -> Result<f64> {
+        if self.equations < N {
+            // the padded zero rows would always count as dependent
+            return self.check_active_rows(q, t);
+        }
         let s = self.assemble_jacobian(&self.poses(q), t, true);
         let ratio = Factorization::Full(s.full_piv_lu()).pivot_ratio();
         if ratio < self.options.pivot_threshold {
@@ -744,6 +782,16 @@ where
         t: f64,
         guess: &SVector<f64, N>,
     ) -> Result<(SVector<f64, N>, Poses<N>, Factorization<N>, usize)> {
+        if self.equations < N {
+            return Err(DynamicsError::ConstraintCount {
+                equations: self.equations,
+                coordinates: N,
+                detail: format!(
+                    "; this system keeps {} degree(s) of freedom (built for forward dynamics)",
+                    N - self.equations
+                ),
+            });
+        }
         let tol = self.options.tolerance * self.length_scale;
         let mut q = *guess;
         let mut res = f64::INFINITY;
