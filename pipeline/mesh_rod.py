@@ -9,6 +9,10 @@ Two commands, both ending with one line of JSON on standard output (progress goe
       discrete surfaces), surface loop, volume, 3D mesh at the target size, second order (10-node
       tetrahedra), optimisation. Deterministic: fixed options, one thread, fixed 3D algorithm and
       random seed, so the same STL and size give the same mesh bit for bit.
+      Meshing a surface reconstructed from an STL is fragile where tiny faces meet large ones (gmsh
+      may stop with "overlapping facets" or even crash), so the mesh is made in a child process and a
+      fixed ladder of classification settings is tried in order (`LADDER`: dihedral angle, curve
+      split angle) until one succeeds; the JSON says which rung was used and why earlier ones failed.
       Writes OUT_DIR/NAME.msh (gmsh MSH 4.1, for the user) and OUT_DIR/NAME.rodmesh (the hand-off
       file the Rust side reads, see below). The .rodmesh is made from the .msh through meshio, i.e.
       by the very same code path as `convert`.
@@ -50,12 +54,17 @@ import argparse
 import json
 import math
 import pathlib
+import subprocess
 import sys
 import time
 
 import numpy as np
 
 FORMAT_HEADER = "rodmesh 1"
+
+# Classification settings tried in order, (dihedral angle, curve split angle) in degrees. The first
+# works for most rods; splitting curves at 60 degree kinks helps where tiny faces meet large ones.
+LADDER = [(40.0, 180.0), (40.0, 60.0), (30.0, 180.0), (50.0, 180.0), (30.0, 60.0), (50.0, 60.0)]
 
 # VTK/meshio tetra10 edges, in the order of the midside nodes 4..9.
 TET10_EDGES = [(0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3)]
@@ -83,7 +92,9 @@ def gmsh_options(size_mm: float, curved: bool) -> dict:
         "Mesh.MeshSizeFactor": 1.0,
         "Mesh.MeshSizeFromCurvature": 0,
         "Mesh.MeshSizeFromPoints": 0,
-        "Mesh.MeshSizeExtendFromBoundary": 1,
+        # sizes of boundary curves extend into the surfaces, not into the volume: a tiny curve (a sliver
+        # face of the STL) refines its surroundings on the surface only
+        "Mesh.MeshSizeExtendFromBoundary": -2,
         "Mesh.Optimize": 1,
         "Mesh.OptimizeNetgen": 1,
         "Mesh.OptimizeThreshold": 0.3,
@@ -145,6 +156,23 @@ def gmsh_volume_mesh(stl: pathlib.Path, size_mm: float, curved: bool, angle_deg:
         gmsh.finalize()
 
 
+def run_attempt(stl: pathlib.Path, size: float, curved: bool, angle: float, curve_angle: float,
+                msh: pathlib.Path) -> tuple[dict | None, str]:
+    """One gmsh run in a child process (gmsh can crash on bad reparametrisations)."""
+    cmd = [sys.executable, str(pathlib.Path(__file__).resolve()), "_attempt", str(stl), str(msh),
+           "--size", repr(size), "--angle", repr(angle), "--curve-angle", repr(curve_angle)]
+    if curved:
+        cmd.append("--curved")
+    run = subprocess.run(cmd, capture_output=True, text=True)
+    if run.returncode == 0:
+        return json.loads(run.stdout.strip().splitlines()[-1]), ""
+    lines = [l for l in run.stderr.strip().splitlines() if l.strip()]
+    why = lines[-1] if lines else f"exit status {run.returncode}"
+    if run.returncode < 0:
+        why = f"gmsh crashed (signal {-run.returncode})"
+    return None, why
+
+
 def cmd_mesh(args) -> dict:
     stl = pathlib.Path(args.stl)
     if not stl.is_file():
@@ -157,25 +185,39 @@ def cmd_mesh(args) -> dict:
     msh = out_dir / f"{name}.msh"
     rodmesh = out_dir / f"{name}.rodmesh"
     t0 = time.perf_counter()
-    log(f"{stl.name}: meshing at {args.size} mm" + (" (curved attempt)" if args.curved else ""))
-    curved = False
-    if args.curved:
-        info = gmsh_volume_mesh(stl, args.size, True, args.angle, args.curve_angle, msh)
-        curved = info["min_scaled_jacobian"] > 0.0
+    ladder = [(args.angle, args.curve_angle)] if args.angle is not None or args.curve_angle is not None else LADDER
+    ladder = [(a if a is not None else LADDER[0][0], c if c is not None else LADDER[0][1]) for a, c in ladder]
+    failed = []
+    info = None
+    for angle, curve_angle in ladder:
+        log(f"{stl.name}: meshing at {args.size} mm (classification {angle:g} deg, curves {curve_angle:g} deg)"
+            + (", curved attempt" if args.curved else ""))
+        curved = False
+        if args.curved:
+            info, why = run_attempt(stl, args.size, True, angle, curve_angle, msh)
+            curved = info is not None and info["min_scaled_jacobian"] > 0.0
+            if info is not None and not curved:
+                log(f"curved mesh has min scaled Jacobian {info['min_scaled_jacobian']:.3g} <= 0: "
+                    "falling back to straight-sided elements")
         if not curved:
-            log(f"curved mesh has min scaled Jacobian {info['min_scaled_jacobian']:.3g} <= 0: "
-                "falling back to straight-sided elements")
-    if not curved:
-        info = gmsh_volume_mesh(stl, args.size, False, args.angle, args.curve_angle, msh)
+            info, why = run_attempt(stl, args.size, False, angle, curve_angle, msh)
+        if info is not None:
+            info.update({"classify_angle_deg": angle, "curve_angle_deg": curve_angle, "curved": curved})
+            break
+        log(f"  failed: {why}")
+        failed.append({"classify_angle_deg": angle, "curve_angle_deg": curve_angle, "error": why})
+    if info is None:
+        raise SystemExit(f"mesh_rod: gmsh could not mesh {stl} at {args.size} mm with any of "
+                         f"{len(ladder)} settings: " + "; ".join(f["error"] for f in failed))
     conv = convert(msh, rodmesh, "mm")
     info.update({
         "stl": str(stl),
         "msh": str(msh),
         "rodmesh": str(rodmesh),
         "size_mm": args.size,
-        "curved": curved,
         "nodes": conv["nodes"],
         "max_midside_offset_rel": conv["max_midside_offset_rel"],
+        "failed_attempts": failed,
         "seconds_total": time.perf_counter() - t0,
     })
     if conv["elements"] != info["elements"]:
@@ -183,6 +225,12 @@ def cmd_mesh(args) -> dict:
     log(f"{info['elements']} tet10, {info['nodes']} nodes, min SICN {info['min_sicn']:.3f}, "
         f"min SJ {info['min_scaled_jacobian']:.3f}, {info['seconds_total']:.1f} s")
     return info
+
+
+def cmd_attempt(args) -> dict:
+    """Internal: one gmsh run, writing the .msh; used by `mesh` in a child process."""
+    return gmsh_volume_mesh(pathlib.Path(args.stl), args.size, args.curved, args.angle, args.curve_angle,
+                            pathlib.Path(args.msh))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -240,7 +288,7 @@ def convert(inp: pathlib.Path, out: pathlib.Path, units: str) -> dict:
 
 
 def write_rodmesh(path: pathlib.Path, points: np.ndarray, tets: np.ndarray, units: str, source: str) -> None:
-    lines = [FORMAT_HEADER, f"# from {source}", f"units {units}", f"nodes {len(points)}"]
+    lines = [FORMAT_HEADER, f"# from {pathlib.Path(source).name}", f"units {units}", f"nodes {len(points)}"]
     lines.extend(f"{x!r} {y!r} {z!r}" for x, y, z in points.tolist())
     lines.append(f"tet10 {len(tets)}")
     lines.extend(" ".join(map(str, row)) for row in tets.tolist())
@@ -267,16 +315,23 @@ def main(argv=None) -> int:
     pm.add_argument("--name", help="output base name (default: the STL's stem)")
     pm.add_argument("--curved", action="store_true",
                     help="try midside nodes on the surface; fall back to straight if any element inverts")
-    pm.add_argument("--angle", type=float, default=40.0,
-                    help="classifySurfaces: dihedral angle (degrees) splitting patches (default 40)")
-    pm.add_argument("--curve-angle", type=float, default=180.0,
-                    help="classifySurfaces: angle (degrees) splitting curves (default 180)")
+    pm.add_argument("--angle", type=float,
+                    help="classifySurfaces: dihedral angle (degrees) splitting patches (default: the ladder)")
+    pm.add_argument("--curve-angle", type=float,
+                    help="classifySurfaces: angle (degrees) splitting curves (default: the ladder)")
+    pa = sub.add_parser("_attempt", help=argparse.SUPPRESS)
+    pa.add_argument("stl")
+    pa.add_argument("msh")
+    pa.add_argument("--size", type=float, required=True)
+    pa.add_argument("--angle", type=float, required=True)
+    pa.add_argument("--curve-angle", type=float, required=True)
+    pa.add_argument("--curved", action="store_true")
     pc = sub.add_parser("convert", help="any meshio volume mesh -> .rodmesh")
     pc.add_argument("input")
     pc.add_argument("output")
     pc.add_argument("--units", default="mm", help="units of the input coordinates: mm (default) or m")
     args = ap.parse_args(argv)
-    info = cmd_mesh(args) if args.cmd == "mesh" else cmd_convert(args)
+    info = {"mesh": cmd_mesh, "convert": cmd_convert, "_attempt": cmd_attempt}[args.cmd](args)
     print(json.dumps(info, sort_keys=True))
     return 0
 

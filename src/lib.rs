@@ -12,6 +12,8 @@
 //!   counters and caps;
 //! - [`free_run`]: scene `free` (thesis ch. 4): the reduction-method equation of motion, its exact
 //!   energy-integral reference, the multibody DAE forms and the work–precision sweep;
+//! - [`fem`]: stage 3, linear elasticity with 10-node tetrahedra (gmsh mesh, faer Cholesky),
+//!   von Mises under F_x and F_y;
 //! - [`study`]: running the stages over every design of a folder;
 //! - [`python_env`]: the project-local Python environment the `pipeline/` scripts run in;
 //! - [`bench`]: benchmarks, reported as ratios against a reference run;
@@ -19,6 +21,7 @@
 
 pub mod bench;
 pub mod cli;
+pub mod fem;
 pub mod free_run;
 pub mod geometry;
 pub mod integrators;

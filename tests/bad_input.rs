@@ -55,6 +55,7 @@ fn each_bad_design_is_reported_and_the_good_one_studied() {
     let o = Command::new(env!("CARGO_BIN_EXE_rodstudy"))
         .args([
             "study",
+            "--skip-fem",
             "--designs",
             d.to_str().unwrap(),
             "--out",

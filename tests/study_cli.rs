@@ -31,6 +31,7 @@ fn study_writes_reports_and_lists_the_broken_design() {
     std::fs::write(designs.path().join("holed.stl"), binary_stl(&open)).unwrap();
     let o = rodstudy(&[
         "study",
+        "--skip-fem",
         "--designs",
         designs.path().to_str().unwrap(),
         "--out",
@@ -43,7 +44,7 @@ fn study_writes_reports_and_lists_the_broken_design() {
         "a failed design gives exit status 1: {stderr}"
     );
     assert!(
-        stderr.contains("ran mass, dynamics driven") && stderr.contains("not yet available: fem"),
+        stderr.contains("ran mass, dynamics driven") && stderr.contains("skipped: fem"),
         "{stderr}"
     );
     let results: serde_json::Value =
@@ -88,6 +89,7 @@ fn empty_designs_folder_is_a_clear_error() {
     let out = tempfile::tempdir().unwrap();
     let o = rodstudy(&[
         "study",
+        "--skip-fem",
         "--designs",
         designs.path().to_str().unwrap(),
         "--out",
@@ -154,12 +156,12 @@ fn second_run_uses_the_cache_and_a_changed_design_reruns_alone() {
         designs.path().to_str().unwrap(),
         out.path().to_str().unwrap(),
     );
-    let first = rodstudy(&["study", "--designs", d, "--out", o]);
+    let first = rodstudy(&["study", "--skip-fem", "--designs", d, "--out", o]);
     assert!(String::from_utf8_lossy(&first.stderr).contains("(0 from the cache)"));
-    let second = rodstudy(&["study", "--designs", d, "--out", o]);
+    let second = rodstudy(&["study", "--skip-fem", "--designs", d, "--out", o]);
     assert!(String::from_utf8_lossy(&second.stderr).contains("(2 from the cache)"));
     std::fs::write(designs.path().join("b.toml"), "name = \"B renamed\"\n").unwrap();
-    let third = rodstudy(&["study", "--designs", d, "--out", o]);
+    let third = rodstudy(&["study", "--skip-fem", "--designs", d, "--out", o]);
     let log = String::from_utf8_lossy(&third.stderr);
     assert!(log.contains("(1 from the cache)"), "{log}");
     assert!(log.contains("a.stl: peak pin force") && log.contains("(cached)"));
@@ -167,7 +169,15 @@ fn second_run_uses_the_cache_and_a_changed_design_reruns_alone() {
         serde_json::from_slice(&std::fs::read(out.path().join("results.json")).unwrap()).unwrap();
     assert_eq!(results["designs"][1]["mass"]["design"], "B renamed");
     // The cached figures are the computed ones.
-    let fresh = rodstudy(&["study", "--designs", d, "--out", o, "--no-cache"]);
+    let fresh = rodstudy(&[
+        "study",
+        "--skip-fem",
+        "--designs",
+        d,
+        "--out",
+        o,
+        "--no-cache",
+    ]);
     assert!(String::from_utf8_lossy(&fresh.stderr).contains("(0 from the cache)"));
     let again: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.path().join("results.json")).unwrap()).unwrap();
@@ -190,7 +200,16 @@ fn configuration_file_sets_the_scene_and_typos_are_refused() {
         out.path().to_str().unwrap(),
         config.to_str().unwrap(),
     );
-    let run = rodstudy(&["study", "--designs", d, "--out", o, "--config", c]);
+    let run = rodstudy(&[
+        "study",
+        "--skip-fem",
+        "--designs",
+        d,
+        "--out",
+        o,
+        "--config",
+        c,
+    ]);
     assert_eq!(
         run.status.code(),
         Some(0),
@@ -209,7 +228,16 @@ fn configuration_file_sets_the_scene_and_typos_are_refused() {
         "{peak} vs {formula}"
     );
     std::fs::write(&config, "[driven]\nspeed = 3.0\n").unwrap();
-    let bad = rodstudy(&["study", "--designs", d, "--out", o, "--config", c]);
+    let bad = rodstudy(&[
+        "study",
+        "--skip-fem",
+        "--designs",
+        d,
+        "--out",
+        o,
+        "--config",
+        c,
+    ]);
     assert_eq!(bad.status.code(), Some(2));
     let e = String::from_utf8_lossy(&bad.stderr);
     assert!(

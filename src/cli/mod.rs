@@ -6,6 +6,7 @@
 mod bench;
 mod check;
 mod dynamics;
+mod fem;
 mod integrators;
 mod mass;
 mod pipeline;
@@ -32,6 +33,8 @@ enum Command {
     /// Stage 2: the crank–slider with each design's rod (peak crank–rod pin force).
     #[command(subcommand)]
     Dynamics(dynamics::DynamicsCommand),
+    /// Stage 3: tet10 FEM of one design under F_x and F_y (the design's peak pin force).
+    Fem(fem::FemArgs),
     /// Work–precision comparison of the integrators on the free run (thesis ch. 4).
     Integrators(integrators::IntegratorsArgs),
     /// Run every stage that exists on every design of a folder and write the reports.
@@ -59,6 +62,7 @@ pub fn main() -> i32 {
     let result = match cli.command {
         Command::Mass(args) => mass::run(args),
         Command::Dynamics(command) => dynamics::run(command),
+        Command::Fem(args) => fem::run(args),
         Command::Integrators(args) => integrators::run(args),
         Command::Study(args) => study::run(args),
         Command::Check(args) => check::run(args),

@@ -28,6 +28,9 @@ pub struct StudyArgs {
     /// Designs studied at once (default: one per core).
     #[arg(long, default_value_t = 0)]
     jobs: usize,
+    /// Leave out the FEM stage (mass and pin force only; no Python, no mesh).
+    #[arg(long)]
+    skip_fem: bool,
     /// Recompute every design even when its cached results are current.
     #[arg(long)]
     no_cache: bool,
@@ -44,6 +47,7 @@ pub fn run(args: StudyArgs) -> Result<i32> {
         config,
         jobs: args.jobs,
         use_cache: !args.no_cache,
+        skip_fem: args.skip_fem,
     };
     let count = crate::geometry::design::find_stl_files(std::slice::from_ref(&args.designs))
         .map(|f| f.len())
@@ -89,12 +93,16 @@ pub fn run(args: StudyArgs) -> Result<i32> {
         bar.finish_and_clear();
     }
     eprintln!(
-        "study: ran {} on {} design(s) in {} ({} from the cache); not yet available: {}",
+        "study: ran {} on {} design(s) in {} ({} from the cache); skipped: {}",
         results.stages_run.join(", "),
         results.designs.len() + results.failed.len(),
         args.designs.display(),
         cached.load(Ordering::SeqCst),
-        results.stages_not_yet_available.join(", ")
+        if results.stages_skipped.is_empty() {
+            "none".to_string()
+        } else {
+            results.stages_skipped.join(", ")
+        }
     );
     let designs: Vec<_> = results.designs.iter().map(|d| &d.mass).collect();
     print!("{}", mass_table(&designs));

@@ -9,7 +9,9 @@ pub mod baseline;
 pub mod cache;
 pub mod config;
 pub mod dynamics_stage;
+pub mod fem_stage;
 pub mod plots;
+pub mod ranking;
 pub mod tables;
 
 use crate::geometry::design::{DesignMass, find_stl_files, mass_of_design};
@@ -19,14 +21,13 @@ use atomic_write::write_atomic;
 use cache::{Cache, design_key};
 use config::StudyConfig;
 use dynamics_stage::{DesignDynamics, dynamics_of_design, write_history_csv};
+use fem_stage::{DesignFem, fem_of_design};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
-/// The stages this version runs, in order, for the report's `stages_run`.
-pub const STAGES_RUN: &[&str] = &["mass", "dynamics driven"];
-/// Stages of the specification not built yet, so the report says what it did not do.
-pub const STAGES_NOT_YET_AVAILABLE: &[&str] = &["fem"];
+/// The stages a study runs, in order, for the report's `stages_run`.
+pub const STAGES: &[&str] = &["mass", "dynamics driven", "fem"];
 
 /// Everything the study found, as written to `results.json`.
 #[derive(Debug, Clone, Serialize)]
@@ -35,7 +36,8 @@ pub struct StudyResults {
     /// The settings used (defaults, `rodstudy.toml` or `--config`).
     pub config: StudyConfig,
     pub stages_run: Vec<String>,
-    pub stages_not_yet_available: Vec<String>,
+    /// Stages left out on purpose (e.g. `fem` with `--skip-fem`).
+    pub stages_skipped: Vec<String>,
     pub designs: Vec<DesignResult>,
     pub failed: Vec<FailedDesign>,
 }
@@ -45,6 +47,8 @@ pub struct StudyResults {
 pub struct DesignResult {
     pub mass: DesignMass,
     pub dynamics: DesignDynamics,
+    /// Stage 3, unless skipped.
+    pub fem: Option<DesignFem>,
     /// The pin-force history (written to its own CSV, not to `results.json`).
     #[serde(skip)]
     pub history: DrivenResult,
@@ -66,6 +70,8 @@ pub struct StudyOptions<'a> {
     pub jobs: usize,
     /// Reuse cached per-design results whose content hash matches.
     pub use_cache: bool,
+    /// Leave out the FEM stage (a force-only study needs no mesh).
+    pub skip_fem: bool,
 }
 
 /// What happened to one design, reported as soon as it is done (for progress output).
@@ -80,6 +86,7 @@ pub struct Progress<'a> {
 struct CachedDesign {
     mass: DesignMass,
     dynamics: DesignDynamics,
+    fem: Option<DesignFem>,
 }
 
 /// Runs the stages on every `*.stl` of `options.designs`, designs in parallel, calling
@@ -102,8 +109,7 @@ pub fn run_study(
         files
             .into_par_iter()
             .map(|f| {
-                let (r, cached) =
-                    study_one(&f, &options.config, options.use_cache.then_some(&cache));
+                let (r, cached) = study_one(&f, options, options.use_cache.then_some(&cache));
                 on_done(Progress {
                     file: &f,
                     cached,
@@ -116,9 +122,14 @@ pub fn run_study(
     let mut results = StudyResults {
         program_version: env!("CARGO_PKG_VERSION").into(),
         config: options.config,
-        stages_run: STAGES_RUN.iter().map(|s| s.to_string()).collect(),
-        stages_not_yet_available: STAGES_NOT_YET_AVAILABLE
+        stages_run: STAGES
             .iter()
+            .filter(|s| !(options.skip_fem && **s == "fem"))
+            .map(|s| s.to_string())
+            .collect(),
+        stages_skipped: STAGES
+            .iter()
+            .filter(|s| options.skip_fem && **s == "fem")
             .map(|s| s.to_string())
             .collect(),
         designs: Vec::new(),
@@ -140,14 +151,21 @@ pub fn run_study(
 /// whether the cache answered.
 fn study_one(
     stl: &Path,
-    config: &StudyConfig,
+    options: &StudyOptions,
     cache: Option<&Cache>,
 ) -> (Result<DesignResult>, bool) {
+    let config = &options.config;
     let id = stl
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let key = cache.and_then(|_| design_key(stl, config).ok());
+    let key = cache.and_then(|_| design_key(stl, config).ok()).map(|k| {
+        if options.skip_fem {
+            format!("{k}-without-fem")
+        } else {
+            k
+        }
+    });
     let scene = config.driven_scene();
     if let (Some(cache), Some(key)) = (cache, &key)
         && let Some(hit) = cache.get::<CachedDesign>(&id, key)
@@ -160,6 +178,7 @@ fn study_one(
             let result = DesignResult {
                 mass: hit.mass,
                 dynamics: hit.dynamics,
+                fem: hit.fem,
                 history,
             };
             return (Ok(result), true);
@@ -169,9 +188,24 @@ fn study_one(
         let mass = mass_of_design(stl)?;
         let (dynamics, history) =
             dynamics_of_design(&mass, &scene, config.driven.gravity, Method::ClosedForm)?;
+        let fem = if options.skip_fem {
+            None
+        } else {
+            let work = options.out.join(".cache").join("mesh").join(&id);
+            let vtu = options.out.join(file_safe(&id));
+            Some(fem_of_design(
+                stl,
+                dynamics.peak_pin_force_n,
+                config,
+                &work,
+                &vtu,
+                None,
+            )?)
+        };
         Ok(DesignResult {
             mass,
             dynamics,
+            fem,
             history,
         })
     })();
@@ -179,6 +213,7 @@ fn study_one(
         let entry = CachedDesign {
             mass: d.mass.clone(),
             dynamics: d.dynamics.clone(),
+            fem: d.fem.clone(),
         };
         // A cache that cannot be written only costs time on the next run.
         let _ = cache.put(&id, key, &entry);
@@ -196,8 +231,10 @@ pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>>
     let csv_path = out.join("mass_properties.csv");
     write_atomic(&csv_path, &csv_table(results)?)?;
     let ranking = out.join("ranking.md");
-    write_atomic(&ranking, ranking_markdown(results).as_bytes())?;
-    let mut written = vec![json, md, csv_path, ranking];
+    write_atomic(&ranking, ranking::markdown(results).as_bytes())?;
+    let ranking_csv = out.join("ranking.csv");
+    write_atomic(&ranking_csv, &ranking::csv(results)?)?;
+    let mut written = vec![json, md, csv_path, ranking, ranking_csv];
     if !results.designs.is_empty() {
         let pin = out.join("pin_force.svg");
         write_atomic(&pin, pin_force_plot(results)?.as_bytes())?;
@@ -297,9 +334,9 @@ fn index_html(results: &StudyResults) -> String {
         })
         .collect();
     format!(
-        "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>rodstudy report</title>\n<style>body{{font-family:sans-serif;max-width:1000px;margin:2em auto}}table{{border-collapse:collapse}}td,th{{border:1px solid #ccc;padding:4px 8px;text-align:right}}td:nth-child(2){{text-align:left}}img{{max-width:100%}}</style></head><body>\n<h1>Connecting-rod design study</h1>\n<p>Stages run: {}. Not yet available: {}. Ranked by peak crank–rod pin force, lowest first.</p>\n<table><tr><th>rank</th><th>design</th><th>mass [kg]</th><th>l1 [mm]</th><th>I_zz [kg·m²]</th><th>I_xx [kg·m²]</th><th>peak pin force [N]</th><th>history</th></tr>\n{rows}</table>\n{}<h2>Pin force over one revolution</h2><img src=\"pin_force.svg\" alt=\"pin force\">\n<h2>Peak pin force</h2><img src=\"peak_force.svg\" alt=\"peak force\">\n<p>All figures: <a href=\"results.json\">results.json</a>, <a href=\"mass_properties.csv\">mass_properties.csv</a>.</p>\n</body></html>\n",
+        "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>rodstudy report</title>\n<style>body{{font-family:sans-serif;max-width:1000px;margin:2em auto}}table{{border-collapse:collapse}}td,th{{border:1px solid #ccc;padding:4px 8px;text-align:right}}td:nth-child(2){{text-align:left}}img{{max-width:100%}}</style></head><body>\n<h1>Connecting-rod design study</h1>\n<p>Stages run: {}. Skipped: {}. Ranked by peak crank–rod pin force, lowest first.</p>\n<table><tr><th>rank</th><th>design</th><th>mass [kg]</th><th>l1 [mm]</th><th>I_zz [kg·m²]</th><th>I_xx [kg·m²]</th><th>peak pin force [N]</th><th>history</th></tr>\n{rows}</table>\n{}<h2>Pin force over one revolution</h2><img src=\"pin_force.svg\" alt=\"pin force\">\n<h2>Peak pin force</h2><img src=\"peak_force.svg\" alt=\"peak force\">\n<p>All figures: <a href=\"results.json\">results.json</a>, <a href=\"mass_properties.csv\">mass_properties.csv</a>.</p>\n</body></html>\n",
         results.stages_run.join(", "),
-        results.stages_not_yet_available.join(", "),
+        results.stages_skipped.join(", "),
         if failed.is_empty() {
             String::new()
         } else {
@@ -321,46 +358,12 @@ fn file_safe(name: &str) -> String {
         .collect()
 }
 
-/// The ranking so far: by peak pin force, lowest first (the stress criterion joins it with the
-/// FEM stage).
-fn ranking_markdown(results: &StudyResults) -> String {
-    let mut ranked: Vec<&DesignResult> = results.designs.iter().collect();
-    ranked.sort_by(|a, b| {
-        a.dynamics
-            .peak_pin_force_n
-            .total_cmp(&b.dynamics.peak_pin_force_n)
-    });
-    let mut out = String::from(
-        "# Ranking of the designs\n\nRanked by the peak crank–rod pin force of the driven crank–slider (scene `driven`; its settings are in `results.json`), lowest first. The stress criterion (FEM stage) is not available yet, so no design is judged on stress.\n\n| rank | design | mass [kg] | l1 [mm] | I_zz [kg·m²] | I_xx [kg·m²] | peak pin force [N] | at crank angle [°] |\n|---|---|---|---|---|---|---|---|\n",
-    );
-    for (k, d) in ranked.iter().enumerate() {
-        out.push_str(&format!(
-            "| {} | {} | {:.4} | {:.2} | {:.5} | {:.6} | {:.1} | {:.2} |\n",
-            k + 1,
-            d.mass.design,
-            d.mass.mass_kg,
-            d.mass.l1_m * 1e3,
-            d.mass.i_zz_kgm2,
-            d.mass.i_xx_kgm2,
-            d.dynamics.peak_pin_force_n,
-            d.dynamics.peak_crank_angle_deg
-        ));
-    }
-    if !results.failed.is_empty() {
-        out.push_str("\n## Failed designs\n\n");
-        for f in &results.failed {
-            out.push_str(&format!("- `{}`: {}\n", f.file, f.error));
-        }
-    }
-    out
-}
-
 fn markdown(results: &StudyResults) -> String {
     let designs: Vec<&DesignMass> = results.designs.iter().map(|d| &d.mass).collect();
     let mut out = format!(
-        "# Mass properties of the designs\n\nStages run: {}. Not yet available: {}.\nI_zz is about the pin axis through the centroid (the one the planar dynamics uses); I_xx is about the rod's long axis (what the thesis' Table 5.1 lists).\n\n",
+        "# Mass properties of the designs\n\nStages run: {}. Skipped: {}.\nI_zz is about the pin axis through the centroid (the one the planar dynamics uses); I_xx is about the rod's long axis (what the thesis' Table 5.1 lists).\n\n",
         results.stages_run.join(", "),
-        results.stages_not_yet_available.join(", ")
+        results.stages_skipped.join(", ")
     );
     out.push_str(&tables::mass_table(&designs));
     if !results.failed.is_empty() {

@@ -1,0 +1,219 @@
+//! `rodstudy fem DESIGN [--mesh FILE] [--size MM] [--force N] [--json] [--out DIR]
+//! [--refine 8,5,3.5]`
+
+use crate::fem::study::refinement_study_stl;
+use crate::fem::{BoreSpec, Material, RodOptions};
+use crate::geometry::design::mass_of_design;
+use crate::geometry::sidecar::DesignSettings;
+use crate::mechanism::Method;
+use crate::python_env::{pipeline_script, python};
+use crate::study::config::StudyConfig;
+use crate::study::dynamics_stage::dynamics_of_design;
+use crate::study::fem_stage::{DesignFem, MESHER, fem_of_design};
+use anyhow::{Result, bail};
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Args)]
+pub struct FemArgs {
+    /// The STL design (its sidecar gives units, pins and axis).
+    design: PathBuf,
+    /// Use this ready volume mesh (gmsh .msh, Abaqus/CalculiX .inp, VTU, Nastran .bdf; tet10)
+    /// as it is, instead of meshing the STL.
+    #[arg(long)]
+    mesh: Option<PathBuf>,
+    /// Target element size [mm] (default 5, or `fem.mesh_size_mm` of the configuration).
+    #[arg(long)]
+    size: Option<f64>,
+    /// Load magnitude [N] of both cases (default: the design's peak pin force).
+    #[arg(long)]
+    force: Option<f64>,
+    /// Settings file (as for `study`).
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Folder for the VTU files and the mesh.
+    #[arg(long, default_value = "reports/fem")]
+    out: PathBuf,
+    /// Print the result as JSON.
+    #[arg(long)]
+    json: bool,
+    /// Refinement study over these element sizes [mm] instead of one analysis, e.g. 8,5,3.5.
+    #[arg(long, value_delimiter = ',')]
+    refine: Option<Vec<f64>>,
+}
+
+pub fn run(args: FemArgs) -> Result<i32> {
+    let mut config = StudyConfig::load(args.config.as_deref())?;
+    if let Some(size) = args.size {
+        config.fem.mesh_size_mm = size;
+    }
+    let force = match args.force {
+        Some(f) if f.is_finite() && f > 0.0 => f,
+        Some(f) => bail!("--force must be a positive number of newtons, got {f}"),
+        None => {
+            let mass = mass_of_design(&args.design)?;
+            let (dynamics, _) = dynamics_of_design(
+                &mass,
+                &config.driven_scene(),
+                config.driven.gravity,
+                Method::ClosedForm,
+            )?;
+            eprintln!(
+                "load: the design's peak pin force, {:.1} N",
+                dynamics.peak_pin_force_n
+            );
+            dynamics.peak_pin_force_n
+        }
+    };
+    if let Some(sizes) = &args.refine {
+        return refine(&args, &config, force, sizes);
+    }
+    let result = fem_of_design(
+        &args.design,
+        force,
+        &config,
+        &args.out.join("mesh"),
+        &args.out,
+        args.mesh.as_deref(),
+    )?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&FemJson::from(&result))?);
+    } else {
+        print_result(&result);
+    }
+    Ok(0)
+}
+
+/// `fem --json`: the stage-3 record with `dofs` and `elements` at the top level.
+#[derive(serde::Serialize)]
+struct FemJson<'a> {
+    dofs: usize,
+    elements: usize,
+    nodes: usize,
+    force_n: f64,
+    fx: &'a crate::fem::LoadCaseResult,
+    fy: &'a crate::fem::LoadCaseResult,
+    mesh: &'a crate::study::fem_stage::MeshSummary,
+    criterion: &'a crate::study::fem_stage::StressVerdict,
+    fem: &'a crate::fem::FemResult,
+}
+
+impl<'a> From<&'a DesignFem> for FemJson<'a> {
+    fn from(d: &'a DesignFem) -> Self {
+        FemJson {
+            dofs: d.fem.dofs,
+            elements: d.fem.elements,
+            nodes: d.fem.nodes,
+            force_n: d.force_n,
+            fx: &d.fem.fx,
+            fy: &d.fem.fy,
+            mesh: &d.mesh,
+            criterion: &d.criterion,
+            fem: &d.fem,
+        }
+    }
+}
+
+fn print_result(d: &DesignFem) {
+    let f = &d.fem;
+    println!(
+        "mesh: {} ({} tet10, {} nodes, {} DOFs); load {:.1} N on the big-end bore (r = {:.2} mm), small-end bore fixed (r = {:.2} mm)",
+        d.mesh.source,
+        f.elements,
+        f.nodes,
+        f.dofs,
+        d.force_n,
+        f.loaded_bore.radius_mm,
+        f.fixed_bore.radius_mm
+    );
+    println!(
+        "\n| case | max von Mises unaveraged [MPa] | averaged [MPa] | away from fixed bore [MPa] | max displacement [mm] | resultant error | reaction balance |\n|---|---|---|---|---|---|---|"
+    );
+    for c in [&f.fx, &f.fy] {
+        println!(
+            "| {} | {:.2} | {:.2} | {:.2} | {:.4} | {:.1e} | {:.1e} |",
+            c.name,
+            c.max_von_mises_unaveraged_mpa,
+            c.max_von_mises_averaged_mpa,
+            c.max_von_mises_away_from_fixed_mpa,
+            c.max_displacement_mm,
+            c.resultant_error_rel,
+            c.reaction_balance_rel
+        );
+    }
+    let t = &f.timings;
+    println!(
+        "\ntimes [s]: assembly {:.2}, symbolic analysis {:.2}, factorisation {:.2}, solve (both cases) {:.2}, stress {:.2}; total {:.2}",
+        t.assembly_s, t.symbolic_s, t.factorisation_s, t.solve_s, t.stress_s, f.total_s
+    );
+    let v = &d.criterion;
+    println!(
+        "criterion: {:.1} MPa ({}) against {:.1} MPa allowed: safety factor {:.2}, {}",
+        v.governing_mpa,
+        v.governing_case,
+        v.allowed_mpa,
+        v.safety_factor,
+        if v.pass { "pass" } else { "FAIL" }
+    );
+    for c in [&f.fx, &f.fy] {
+        if let Some(vtu) = &c.vtu {
+            eprintln!("wrote {}", vtu.display());
+        }
+    }
+}
+
+fn refine(args: &FemArgs, config: &StudyConfig, force: f64, sizes: &[f64]) -> Result<i32> {
+    let settings = DesignSettings::for_stl(&args.design)?;
+    let mm = |v: nalgebra::Vector3<f64>| [v.x * 1e3, v.y * 1e3, v.z * 1e3];
+    let a = settings.pin_axis;
+    let bores = BoreSpec::from_mm(
+        mm(settings.crank_pin_m),
+        mm(settings.piston_pin_m),
+        [a.x, a.y, a.z],
+    );
+    let material = Material {
+        youngs_modulus_pa: config.fem.youngs_modulus_pa,
+        poisson_ratio: config.fem.poisson_ratio,
+    };
+    let study = refinement_study_stl(
+        &python()?,
+        &pipeline_script(MESHER),
+        &args.design,
+        sizes,
+        &args.out.join("refinement"),
+        &material,
+        &bores,
+        force,
+        &RodOptions::default(),
+    )?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&study)?);
+        return Ok(0);
+    }
+    println!(
+        "refinement study of {} at {:.1} N\n",
+        args.design.display(),
+        force
+    );
+    println!(
+        "| size [mm] | elements | DOFs | F_x unaveraged / averaged / away [MPa] | F_y unaveraged / averaged / away [MPa] | F_y max displ. [mm] | mesh [s] | solve [s] |\n|---|---|---|---|---|---|---|---|"
+    );
+    for l in &study.levels {
+        println!(
+            "| {} | {} | {} | {:.1} / {:.1} / {:.1} | {:.1} / {:.1} / {:.1} | {:.4} | {:.1} | {:.2} |",
+            l.size_mm,
+            l.elements,
+            l.dofs,
+            l.fx.max_unaveraged_mpa,
+            l.fx.max_averaged_mpa,
+            l.fx.max_away_from_fixed_mpa,
+            l.fy.max_unaveraged_mpa,
+            l.fy.max_averaged_mpa,
+            l.fy.max_away_from_fixed_mpa,
+            l.fy.max_displacement_mm,
+            l.mesh_s,
+            l.solve_total_s
+        );
+    }
+    Ok(0)
+}

@@ -1,0 +1,274 @@
+//! Finding the pin bores on the boundary of the mesh (SPEC Stage 3: the small-end bore B is fixed,
+//! the big-end bore A is loaded).
+//!
+//! For a pin axis (a point and a direction, inputs) the bore wall is the set of boundary faces that
+//! 1. face the axis: the outward normal at the face centroid points towards the axis within
+//!    `normal_tolerance_deg` of the radial direction, and
+//! 2. lie on the innermost such cylinder: all three corners at radius r_bore within
+//!    `radius_tolerance` (relative), where r_bore is the smallest "largest corner radius" among the
+//!    faces of 1. The radius is found, not assumed.
+//!
+//! Faces are selected by their corners (midside nodes of a straight face on a faceted bore lie on
+//! chords, inside the cylinder), and all six nodes of a selected face belong to the set.
+//! The set must be plausible: its area close to 2π r × its axial length (`min_coverage`) and no
+//! angular gap above 90° around the axis; an empty or implausible set is an error naming the bore.
+
+use serde::{Deserialize, Serialize};
+
+use super::boundary::{BoundaryFace, dot, face_area, face_coords, face_normal, face_point, norm};
+use super::error::{FemError, Result};
+use super::mesh::TetMesh;
+use super::quadrature::TRI6;
+
+/// The two pin axes and the tolerances of the bore search. Centres in metres.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BoreSpec {
+    /// A point on the crank-pin axis (big end, loaded bore A), m.
+    pub loaded_centre_m: [f64; 3],
+    /// A point on the piston-pin axis (small end, fixed bore B), m.
+    pub fixed_centre_m: [f64; 3],
+    /// Pin axis direction (normalised on use).
+    pub axis: [f64; 3],
+    /// Relative tolerance on the corner radii of bore faces (default 0.01).
+    pub radius_tolerance: f64,
+    /// Largest angle between a bore face's inward normal and the radial direction, degrees (default 30).
+    pub normal_tolerance_deg: f64,
+    /// Smallest accepted area / (2π r × axial length) of a bore set (default 0.85).
+    pub min_coverage: f64,
+}
+
+impl Default for BoreSpec {
+    /// The rodstudy mechanism interface: A = (0, 0, 0), B = (180, 0, 0) mm, pin axis z.
+    fn default() -> Self {
+        BoreSpec::from_mm([0.0, 0.0, 0.0], [180.0, 0.0, 0.0], [0.0, 0.0, 1.0])
+    }
+}
+
+impl BoreSpec {
+    /// Pin centres in millimetres (as in the sidecar), default tolerances.
+    pub fn from_mm(loaded_centre_mm: [f64; 3], fixed_centre_mm: [f64; 3], axis: [f64; 3]) -> Self {
+        BoreSpec {
+            loaded_centre_m: loaded_centre_mm.map(|v| v * 1e-3),
+            fixed_centre_m: fixed_centre_mm.map(|v| v * 1e-3),
+            axis,
+            radius_tolerance: 0.01,
+            normal_tolerance_deg: 30.0,
+            min_coverage: 0.85,
+        }
+    }
+
+    /// Unit axis; error if zero or not finite.
+    pub fn unit_axis(&self) -> Result<[f64; 3]> {
+        let l = norm(self.axis);
+        if !(l.is_finite() && l > 0.0) {
+            return Err(FemError::InvalidInput(format!(
+                "pin axis {:?} has no direction",
+                self.axis
+            )));
+        }
+        Ok(self.axis.map(|v| v / l))
+    }
+}
+
+/// Which bore.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum BoreRole {
+    /// Big-end bore A (crank pin), carries the load.
+    Loaded,
+    /// Small-end bore B (piston pin), fixed.
+    Fixed,
+}
+
+impl std::fmt::Display for BoreRole {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            BoreRole::Loaded => "loaded big-end bore A",
+            BoreRole::Fixed => "fixed small-end bore B",
+        })
+    }
+}
+
+/// A bore wall found on the mesh boundary.
+#[derive(Clone, Debug)]
+pub struct BoreSurface {
+    /// Which bore.
+    pub role: BoreRole,
+    /// The pin centre it was searched around, m.
+    pub centre_m: [f64; 3],
+    /// The radius found (largest corner radius of the innermost face), m.
+    pub radius_m: f64,
+    /// The faces (6 global node indices each, outward order).
+    pub faces: Vec<[usize; 6]>,
+    /// All nodes of those faces, sorted.
+    pub nodes: Vec<usize>,
+    /// Area of the faces, m².
+    pub area_m2: f64,
+    /// Axial extent of the set (min, max of the axial coordinate from the centre), m.
+    pub axial_range_m: [f64; 2],
+    /// area / (2π r × axial length).
+    pub coverage: f64,
+    /// Largest angular gap between corners of the set around the axis, degrees.
+    pub max_angular_gap_deg: f64,
+}
+
+/// Finds one bore wall, see the module documentation.
+pub fn find_bore(
+    mesh: &TetMesh,
+    boundary: &[BoundaryFace],
+    role: BoreRole,
+    centre: [f64; 3],
+    spec: &BoreSpec,
+) -> Result<BoreSurface> {
+    let axis = spec.unit_axis()?;
+    let centre_mm = centre.map(|v| v * 1e3);
+    let not_found = |reason: String| FemError::BoreNotFound {
+        role: role.to_string(),
+        centre_mm,
+        reason,
+    };
+    let implausible = |reason: String| FemError::ImplausibleBore {
+        role: role.to_string(),
+        centre_mm,
+        reason,
+    };
+    let radial = |p: [f64; 3]| -> ([f64; 3], f64) {
+        let v = [p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]];
+        let along = dot(v, axis);
+        let r = [
+            v[0] - along * axis[0],
+            v[1] - along * axis[1],
+            v[2] - along * axis[2],
+        ];
+        (r, along)
+    };
+    let cos_tol = spec.normal_tolerance_deg.to_radians().cos();
+    // 1. faces whose outward normal points at the axis
+    let mut cands: Vec<(usize, f64, [f64; 3])> = Vec::new(); // (face, max corner radius, corner radii)
+    for (i, f) in boundary.iter().enumerate() {
+        let x = face_coords(mesh, &f.nodes);
+        let (pc, _, _) = face_point(&x, [1.0 / 3.0, 1.0 / 3.0]);
+        let (rv, _) = radial(pc);
+        let rc = norm(rv);
+        if rc == 0.0 {
+            continue;
+        }
+        let n = face_normal(&x);
+        if dot(n, rv) / rc <= -cos_tol {
+            let radii = [0, 1, 2].map(|a| norm(radial(x[a]).0));
+            cands.push((i, radii[0].max(radii[1]).max(radii[2]), radii));
+        }
+    }
+    let Some(r_bore) = cands.iter().map(|c| c.1).min_by(|a, b| a.total_cmp(b)) else {
+        return Err(not_found("no boundary face faces the pin axis".into()));
+    };
+    if r_bore <= 0.0 {
+        return Err(not_found("a boundary face touches the pin axis".into()));
+    }
+    // 2. the innermost cylinder
+    let (lo, hi) = (
+        r_bore * (1.0 - spec.radius_tolerance),
+        r_bore * (1.0 + spec.radius_tolerance),
+    );
+    let sel: Vec<usize> = cands
+        .iter()
+        .filter(|c| c.2.iter().all(|r| *r >= lo && *r <= hi))
+        .map(|c| c.0)
+        .collect();
+    if sel.len() < 3 {
+        return Err(implausible(format!(
+            "only {} boundary face(s) at radius {:.3} mm",
+            sel.len(),
+            r_bore * 1e3
+        )));
+    }
+    let faces: Vec<[usize; 6]> = sel.iter().map(|&i| boundary[i].nodes).collect();
+    let mut nodes: Vec<usize> = faces.iter().flatten().copied().collect();
+    nodes.sort_unstable();
+    nodes.dedup();
+    let area_m2: f64 = faces
+        .iter()
+        .map(|f| face_area(&face_coords(mesh, f), &TRI6))
+        .sum();
+    // axial range and angular coverage from the corners
+    let e1 = {
+        let t = if axis[0].abs() < 0.9 {
+            [1.0, 0.0, 0.0]
+        } else {
+            [0.0, 1.0, 0.0]
+        };
+        let d = dot(t, axis);
+        let v = [t[0] - d * axis[0], t[1] - d * axis[1], t[2] - d * axis[2]];
+        v.map(|c| c / norm(v))
+    };
+    let e2 = super::boundary::cross(axis, e1);
+    let (mut zmin, mut zmax) = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut angles = Vec::with_capacity(3 * faces.len());
+    for f in &faces {
+        for &n in &f[..3] {
+            let (rv, along) = radial(mesh.nodes()[n]);
+            zmin = zmin.min(along);
+            zmax = zmax.max(along);
+            angles.push(dot(rv, e2).atan2(dot(rv, e1)).to_degrees());
+        }
+    }
+    angles.sort_by(|a, b| a.total_cmp(b));
+    let mut gap = 360.0 + angles[0] - angles[angles.len() - 1];
+    for w in angles.windows(2) {
+        gap = f64::max(gap, w[1] - w[0]);
+    }
+    let length = zmax - zmin;
+    let coverage = area_m2 / (2.0 * std::f64::consts::PI * r_bore * length);
+    let plausible = length > 0.0 && coverage >= spec.min_coverage && coverage <= 1.05;
+    if !plausible {
+        return Err(implausible(format!(
+            "{} faces at radius {:.3} mm cover {:.1} mm² over an axial length of {:.3} mm: {:.1} % of a \
+             full cylinder wall (expected {:.0}–105 %); is the pin centre right?",
+            faces.len(),
+            r_bore * 1e3,
+            area_m2 * 1e6,
+            length * 1e3,
+            100.0 * coverage,
+            100.0 * spec.min_coverage
+        )));
+    }
+    if gap > 90.0 {
+        return Err(implausible(format!(
+            "the faces at radius {:.3} mm leave a gap of {gap:.0}° around the axis",
+            r_bore * 1e3
+        )));
+    }
+    Ok(BoreSurface {
+        role,
+        centre_m: centre,
+        radius_m: r_bore,
+        faces,
+        nodes,
+        area_m2,
+        axial_range_m: [zmin, zmax],
+        coverage,
+        max_angular_gap_deg: gap,
+    })
+}
+
+/// Finds both bores; they must not share nodes. Returns (loaded A, fixed B).
+pub fn find_bores(
+    mesh: &TetMesh,
+    boundary: &[BoundaryFace],
+    spec: &BoreSpec,
+) -> Result<(BoreSurface, BoreSurface)> {
+    let loaded = find_bore(mesh, boundary, BoreRole::Loaded, spec.loaded_centre_m, spec)?;
+    let fixed = find_bore(mesh, boundary, BoreRole::Fixed, spec.fixed_centre_m, spec)?;
+    let shared = loaded
+        .nodes
+        .iter()
+        .filter(|n| fixed.nodes.binary_search(n).is_ok())
+        .count();
+    if shared > 0 {
+        return Err(FemError::ImplausibleBore {
+            role: BoreRole::Fixed.to_string(),
+            centre_mm: spec.fixed_centre_m.map(|v| v * 1e3),
+            reason: format!("it shares {shared} nodes with the loaded bore"),
+        });
+    }
+    Ok((loaded, fixed))
+}

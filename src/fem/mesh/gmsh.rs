@@ -1,0 +1,177 @@
+//! Runs the Python mesher `pipeline/mesh_rod.py` (gmsh + meshio) and reads its result.
+//!
+//! The interpreter path is an argument (the caller manages the project's virtual environment).
+//! The script prints progress on standard error and one JSON line on standard output, which is
+//! parsed into [`MeshReport`]. gmsh's remeshing of a surface reconstructed from an STL can fail where
+//! tiny faces meet large ones; the script then tries a fixed ladder of classification settings
+//! (reported in `classify_angle_deg`, `curve_angle_deg`, `failed_attempts`), so the result stays
+//! deterministic.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+
+use super::TetMesh;
+use super::rodmesh::read_rodmesh;
+use crate::fem::error::{FemError, Result};
+
+/// What the mesher reports (quality figures from gmsh's `getElementQualities`).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct MeshReport {
+    /// Target element size, mm.
+    pub size_mm: f64,
+    /// Number of 10-node tetrahedra.
+    pub elements: usize,
+    /// Number of nodes.
+    pub nodes: usize,
+    /// Smallest signed inverse condition number ("minSICN") over the elements (1 = regular tet).
+    pub min_sicn: f64,
+    /// Mean of the elements' minSICN.
+    pub mean_sicn: f64,
+    /// Smallest scaled Jacobian ("minSJ"); 1 for straight-sided elements.
+    pub min_scaled_jacobian: f64,
+    /// Whether midside nodes were placed on the surface (else straight-sided elements).
+    pub curved: bool,
+    /// Dihedral angle of gmsh's surface classification that succeeded, degrees.
+    #[serde(default)]
+    pub classify_angle_deg: f64,
+    /// Curve split angle of the classification that succeeded, degrees.
+    #[serde(default)]
+    pub curve_angle_deg: f64,
+    /// Classification settings tried before and why they failed (gmsh errors or crashes).
+    #[serde(default)]
+    pub failed_attempts: Vec<serde_json::Value>,
+    /// The gmsh mesh written (MSH 4.1).
+    pub msh: PathBuf,
+    /// The hand-off file read.
+    pub rodmesh: PathBuf,
+    /// Wall time of the mesher as it measured it, s.
+    pub seconds_total: f64,
+    /// gmsh version.
+    pub gmsh_version: String,
+    /// Wall time including Python start-up, s (measured here).
+    #[serde(default)]
+    pub seconds_wall: f64,
+}
+
+/// A mesh made from an STL, with the mesher's report.
+#[derive(Clone, Debug)]
+pub struct MeshedRod {
+    /// The mesh, metres.
+    pub mesh: TetMesh,
+    /// The mesher's report.
+    pub report: MeshReport,
+}
+
+fn run(python: &Path, script: &Path, args: &[&std::ffi::OsStr]) -> Result<(String, f64)> {
+    if !script.is_file() {
+        return Err(FemError::Mesher(format!(
+            "mesher script not found: {}",
+            script.display()
+        )));
+    }
+    let t0 = Instant::now();
+    let out = Command::new(python)
+        .arg(script)
+        .args(args)
+        .output()
+        .map_err(|e| FemError::Mesher(format!("cannot run {}: {e}", python.display())))?;
+    let secs = t0.elapsed().as_secs_f64();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if !out.status.success() {
+        let tail: Vec<&str> = stderr
+            .lines()
+            .rev()
+            .take(15)
+            .collect::<Vec<_>>()
+            .into_iter()
+            .rev()
+            .collect();
+        return Err(FemError::Mesher(format!(
+            "{} {} exited with {}:\n{}",
+            python.display(),
+            script.display(),
+            out.status,
+            tail.join("\n")
+        )));
+    }
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let last = stdout
+        .lines()
+        .rev()
+        .find(|l| l.trim_start().starts_with('{'))
+        .ok_or_else(|| {
+            FemError::Mesher(format!(
+                "no JSON report on standard output; stderr:\n{stderr}"
+            ))
+        })?;
+    Ok((last.to_string(), secs))
+}
+
+/// Meshes `stl` (millimetres) with 10-node tetrahedra of target size `size_mm` by running
+/// `python script mesh STL OUT_DIR --size SIZE`, and reads the resulting `OUT_DIR/<stem>.rodmesh`.
+pub fn mesh_stl(
+    python: &Path,
+    script: &Path,
+    stl: &Path,
+    size_mm: f64,
+    out_dir: &Path,
+) -> Result<MeshedRod> {
+    if !(size_mm.is_finite() && size_mm > 0.0) {
+        return Err(FemError::InvalidInput(format!(
+            "mesh size must be > 0 mm, got {size_mm}"
+        )));
+    }
+    std::fs::create_dir_all(out_dir).map_err(|e| FemError::io(out_dir, e))?;
+    let size = format!("{size_mm}");
+    let (json, secs) = run(
+        python,
+        script,
+        &[
+            "mesh".as_ref(),
+            stl.as_os_str(),
+            out_dir.as_os_str(),
+            "--size".as_ref(),
+            size.as_ref(),
+        ],
+    )?;
+    let mut report: MeshReport = serde_json::from_str(&json)
+        .map_err(|e| FemError::Mesher(format!("cannot parse the mesher's report ({e}): {json}")))?;
+    report.seconds_wall = secs;
+    let mesh = read_rodmesh(&report.rodmesh)?;
+    if mesh.n_elements() != report.elements {
+        return Err(FemError::Mesher(format!(
+            "{} has {} elements, the mesher reported {}",
+            report.rodmesh.display(),
+            mesh.n_elements(),
+            report.elements
+        )));
+    }
+    Ok(MeshedRod { mesh, report })
+}
+
+/// Converts a user's volume mesh (anything meshio reads: gmsh .msh, Abaqus/CalculiX .inp, VTU,
+/// Nastran .bdf) with `python script convert IN OUT --units UNITS` and reads the result.
+/// `units` is "mm" or "m" (the input's coordinates).
+pub fn convert_mesh(
+    python: &Path,
+    script: &Path,
+    input: &Path,
+    output: &Path,
+    units: &str,
+) -> Result<TetMesh> {
+    run(
+        python,
+        script,
+        &[
+            "convert".as_ref(),
+            input.as_os_str(),
+            output.as_os_str(),
+            "--units".as_ref(),
+            units.as_ref(),
+        ],
+    )?;
+    read_rodmesh(output)
+}

@@ -1,0 +1,403 @@
+//! The rod analysis of SPEC Stage 3 / thesis §5.3: small-end bore B fixed (all DOFs), big-end bore A
+//! loaded by a uniform traction with resultant F along A→B (case `fx`) and, separately, in the plane
+//! of motion perpendicular to it (case `fy` = pin axis × A→B); both cases from one factorisation.
+//!
+//! Reported per case: max von Mises element-nodal unaveraged (as NX reports), nodally averaged, and
+//! nodally averaged outside a band around the fixed bore (the convergent measure: the edge of a fully
+//! fixed surface is a singularity whose peak grows under refinement), each with its location; max
+//! displacement; the load resultant check and the reaction balance.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+
+use super::bores::{BoreSpec, BoreSurface, find_bores};
+use super::boundary::{boundary_faces, cross, norm};
+use super::element::QuadratureChoice;
+use super::error::{FemError, Result};
+use super::load::uniform_traction_with_resultant;
+use super::material::Material;
+use super::mesh::TetMesh;
+use super::statics::{StaticProblem, Timings, solve_static};
+use super::stress::{
+    StressField, displacement_magnitudes, nodes_away_from, peak_nodal, peak_unaveraged,
+    stress_field,
+};
+use super::vtu::{VtuField, write_vtu};
+
+/// Options of [`solve_rod`].
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct RodOptions {
+    /// Element quadrature (default: 4-point for straight, 14-point for curved elements).
+    pub quadrature: QuadratureChoice,
+    /// Width of the band around the fixed bore excluded from the "away from fixed" measure, m.
+    /// `None`: the mesh's mean edge length (one element size).
+    pub fixed_band_m: Option<f64>,
+    /// Write ParaView files `<vtu_dir>/<vtu_stem>_fx.vtu` and `_fy.vtu` when set.
+    pub vtu_dir: Option<PathBuf>,
+    /// Base name of the VTU files (default "rod").
+    pub vtu_stem: Option<String>,
+}
+
+/// Results of one load case. Stresses in MPa, lengths in mm, forces in N.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct LoadCaseResult {
+    /// "fx" or "fy".
+    pub name: String,
+    /// Unit direction of the resultant.
+    pub direction: [f64; 3],
+    /// Magnitude of the resultant, N.
+    pub force_n: f64,
+    /// Max element-nodal (unaveraged) von Mises.
+    pub max_von_mises_unaveraged_mpa: f64,
+    /// Where (node coordinates, mm).
+    pub max_von_mises_unaveraged_at_mm: [f64; 3],
+    /// In which element.
+    pub max_von_mises_unaveraged_element: usize,
+    /// Max nodally averaged von Mises.
+    pub max_von_mises_averaged_mpa: f64,
+    /// Where.
+    pub max_von_mises_averaged_at_mm: [f64; 3],
+    /// Max nodally averaged von Mises at nodes at least the band width from the fixed bore surface.
+    pub max_von_mises_away_from_fixed_mpa: f64,
+    /// Where.
+    pub max_von_mises_away_from_fixed_at_mm: [f64; 3],
+    /// The same for the unaveraged values.
+    pub max_von_mises_unaveraged_away_from_fixed_mpa: f64,
+    /// Max displacement magnitude.
+    pub max_displacement_mm: f64,
+    /// Where.
+    pub max_displacement_at_mm: [f64; 3],
+    /// Sum of the applied nodal forces, N.
+    pub applied_resultant_n: [f64; 3],
+    /// |applied − requested| / F.
+    pub resultant_error_rel: f64,
+    /// Sum of the reactions at the fixed bore (K u − f over its DOFs), N.
+    pub reaction_n: [f64; 3],
+    /// |reaction + applied| / F.
+    pub reaction_balance_rel: f64,
+    /// ‖K u − f‖ / ‖f‖ over the free DOFs.
+    pub solve_residual_rel: f64,
+    /// ParaView file, if written.
+    pub vtu: Option<PathBuf>,
+}
+
+/// A bore as found.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct BoreSummary {
+    /// Radius found, mm.
+    pub radius_mm: f64,
+    /// Area of its faces, mm².
+    pub area_mm2: f64,
+    /// Axial length, mm.
+    pub axial_length_mm: f64,
+    /// area / (2π r × length).
+    pub coverage: f64,
+    /// Boundary faces.
+    pub faces: usize,
+    /// Nodes.
+    pub nodes: usize,
+}
+
+impl From<&BoreSurface> for BoreSummary {
+    fn from(b: &BoreSurface) -> Self {
+        BoreSummary {
+            radius_mm: b.radius_m * 1e3,
+            area_mm2: b.area_m2 * 1e6,
+            axial_length_mm: (b.axial_range_m[1] - b.axial_range_m[0]) * 1e3,
+            coverage: b.coverage,
+            faces: b.faces.len(),
+            nodes: b.nodes.len(),
+        }
+    }
+}
+
+/// Results of [`solve_rod`].
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct FemResult {
+    /// Load along A→B.
+    pub fx: LoadCaseResult,
+    /// Load perpendicular, in the plane of motion.
+    pub fy: LoadCaseResult,
+    /// Nodes.
+    pub nodes: usize,
+    /// Elements (10-node tetrahedra).
+    pub elements: usize,
+    /// DOFs (3 per node).
+    pub dofs: usize,
+    /// Free DOFs (equations).
+    pub equations: usize,
+    /// Stored entries of K (upper triangle).
+    pub nnz_k: usize,
+    /// Stored entries of the Cholesky factor.
+    pub nnz_l: usize,
+    /// Curved elements.
+    pub curved_elements: usize,
+    /// Quadrature choice.
+    pub quadrature: QuadratureChoice,
+    /// Material.
+    pub material: Material,
+    /// Mean element edge length, mm.
+    pub mean_edge_mm: f64,
+    /// Band around the fixed bore excluded from the "away" measure, mm.
+    pub fixed_band_mm: f64,
+    /// The loaded bore.
+    pub loaded_bore: BoreSummary,
+    /// The fixed bore.
+    pub fixed_bore: BoreSummary,
+    /// Times of the stages, s.
+    pub timings: Timings,
+    /// Total wall time of the analysis, s.
+    pub total_s: f64,
+}
+
+/// Full fields of a rod analysis (for post-processing beyond the figures).
+#[derive(Clone, Debug)]
+pub struct RodSolution {
+    /// The figures.
+    pub result: FemResult,
+    /// Displacements (3 per node, m) for fx and fy.
+    pub displacements: [Vec<f64>; 2],
+    /// Stresses for fx and fy.
+    pub stresses: [StressField; 2],
+    /// Loaded bore A.
+    pub loaded: BoreSurface,
+    /// Fixed bore B.
+    pub fixed: BoreSurface,
+    /// Nodes outside the band around the fixed bore.
+    pub away_from_fixed: Vec<bool>,
+}
+
+/// Analyses a rod: see the module documentation. `force_n` > 0 is the magnitude of both cases.
+pub fn solve_rod(
+    mesh: &TetMesh,
+    material: &Material,
+    bores: &BoreSpec,
+    force_n: f64,
+    options: &RodOptions,
+) -> Result<FemResult> {
+    Ok(solve_rod_fields(mesh, material, bores, force_n, options)?.result)
+}
+
+/// [`solve_rod`] returning the fields too.
+pub fn solve_rod_fields(
+    mesh: &TetMesh,
+    material: &Material,
+    bores: &BoreSpec,
+    force_n: f64,
+    options: &RodOptions,
+) -> Result<RodSolution> {
+    let t_all = Instant::now();
+    material.validate()?;
+    if !(force_n.is_finite() && force_n > 0.0) {
+        return Err(FemError::InvalidInput(format!(
+            "force must be > 0 N, got {force_n}"
+        )));
+    }
+    let axis = bores.unit_axis()?;
+    let boundary = boundary_faces(mesh)?;
+    let (loaded, fixed) = find_bores(mesh, &boundary, bores)?;
+
+    // directions: x along A→B (perpendicular to the pin axis), y = axis × x
+    let ab: [f64; 3] = std::array::from_fn(|j| bores.fixed_centre_m[j] - bores.loaded_centre_m[j]);
+    let along = super::boundary::dot(ab, axis);
+    let abp: [f64; 3] = std::array::from_fn(|j| ab[j] - along * axis[j]);
+    let l = norm(abp);
+    if l.is_nan() || l <= 0.0 {
+        return Err(FemError::InvalidInput(
+            "the pin centres lie on one pin axis".into(),
+        ));
+    }
+    let ex = abp.map(|v| v / l);
+    let ey = cross(axis, ex);
+    let cases = [("fx", ex), ("fy", ey)];
+    let loads = cases
+        .iter()
+        .map(|(_, d)| uniform_traction_with_resultant(mesh, &loaded.faces, d.map(|v| v * force_n)))
+        .collect::<Result<Vec<_>>>()?;
+
+    let prescribed: Vec<(usize, f64)> = fixed
+        .nodes
+        .iter()
+        .flat_map(|&n| (0..3).map(move |j| (3 * n + j, 0.0)))
+        .collect();
+    let problem = StaticProblem {
+        mesh,
+        material: *material,
+        prescribed,
+        loads: loads.iter().map(|l| l.forces.clone()).collect(),
+        quadrature: options.quadrature,
+    };
+    let sol = solve_static(&problem)?;
+
+    let t_stress = Instant::now();
+    let band = options
+        .fixed_band_m
+        .unwrap_or_else(|| mesh.mean_edge_length());
+    let away = nodes_away_from(mesh, &fixed.faces, band);
+    let mut results = Vec::new();
+    let mut fields = Vec::new();
+    for (c, ((name, dir), load)) in cases.iter().zip(&loads).enumerate() {
+        let u = &sol.displacements[c];
+        let field = stress_field(mesh, material, u)?;
+        let vm_avg = field.von_mises_averaged();
+        let un = peak_unaveraged(mesh, &field, None);
+        let av = peak_nodal(mesh, &vm_avg, None);
+        let away_av = peak_nodal(mesh, &vm_avg, Some(&away));
+        let away_un = peak_unaveraged(mesh, &field, Some(&away));
+        let umag = displacement_magnitudes(u);
+        let dmax = peak_nodal(mesh, &umag, None);
+        let mut reaction = [0.0; 3];
+        for (d, r) in sol.reactions[c].iter().enumerate() {
+            reaction[d % 3] += r;
+        }
+        let bal = norm(std::array::from_fn(|j| reaction[j] + load.resultant_n[j])) / force_n;
+        if bal > 1e-6 {
+            return Err(FemError::Check(format!(
+                "case {name}: reactions {reaction:?} N do not balance the load {:?} N (relative {bal:.2e})",
+                load.resultant_n
+            )));
+        }
+        let vtu = match &options.vtu_dir {
+            Some(dir) => {
+                std::fs::create_dir_all(dir).map_err(|e| FemError::io(dir, e))?;
+                let stem = options.vtu_stem.as_deref().unwrap_or("rod");
+                let path = dir.join(format!("{stem}_{name}.vtu"));
+                write_case_vtu(&path, mesh, u, &field, &vm_avg, &fixed, &loaded, &away)?;
+                Some(path)
+            }
+            None => None,
+        };
+        let mm = |p: [f64; 3]| p.map(|v| v * 1e3);
+        results.push(LoadCaseResult {
+            name: name.to_string(),
+            direction: *dir,
+            force_n,
+            max_von_mises_unaveraged_mpa: un.value * 1e-6,
+            max_von_mises_unaveraged_at_mm: mm(un.location_m),
+            max_von_mises_unaveraged_element: un.element.unwrap_or(0),
+            max_von_mises_averaged_mpa: av.value * 1e-6,
+            max_von_mises_averaged_at_mm: mm(av.location_m),
+            max_von_mises_away_from_fixed_mpa: away_av.value * 1e-6,
+            max_von_mises_away_from_fixed_at_mm: mm(away_av.location_m),
+            max_von_mises_unaveraged_away_from_fixed_mpa: away_un.value * 1e-6,
+            max_displacement_mm: dmax.value * 1e3,
+            max_displacement_at_mm: mm(dmax.location_m),
+            applied_resultant_n: load.resultant_n,
+            resultant_error_rel: load.resultant_error_rel,
+            reaction_n: reaction,
+            reaction_balance_rel: bal,
+            solve_residual_rel: sol.residual_rel[c],
+            vtu,
+        });
+        fields.push(field);
+    }
+    let mut timings = sol.timings;
+    timings.stress_s = t_stress.elapsed().as_secs_f64();
+    let fy = results.pop().expect("two cases");
+    let fx = results.pop().expect("two cases");
+    let result = FemResult {
+        fx,
+        fy,
+        nodes: mesh.n_nodes(),
+        elements: mesh.n_elements(),
+        dofs: sol.stats.dofs,
+        equations: sol.stats.equations,
+        nnz_k: sol.stats.nnz_k,
+        nnz_l: sol.stats.nnz_l,
+        curved_elements: sol.stats.curved_elements,
+        quadrature: options.quadrature,
+        material: *material,
+        mean_edge_mm: mesh.mean_edge_length() * 1e3,
+        fixed_band_mm: band * 1e3,
+        loaded_bore: (&loaded).into(),
+        fixed_bore: (&fixed).into(),
+        timings,
+        total_s: t_all.elapsed().as_secs_f64(),
+    };
+    let [d0, d1]: [Vec<f64>; 2] = sol
+        .displacements
+        .try_into()
+        .map_err(|_| FemError::Check("two cases".into()))?;
+    let [s0, s1]: [StressField; 2] = fields
+        .try_into()
+        .map_err(|_| FemError::Check("two cases".into()))?;
+    Ok(RodSolution {
+        result,
+        displacements: [d0, d1],
+        stresses: [s0, s1],
+        loaded,
+        fixed,
+        away_from_fixed: away,
+    })
+}
+
+#[allow(clippy::too_many_arguments)]
+fn write_case_vtu(
+    path: &std::path::Path,
+    mesh: &TetMesh,
+    u: &[f64],
+    field: &StressField,
+    vm_avg: &[f64],
+    fixed: &BoreSurface,
+    loaded: &BoreSurface,
+    away: &[bool],
+) -> Result<()> {
+    let u_mm: Vec<f64> = u.iter().map(|v| v * 1e3).collect();
+    let vm_mpa: Vec<f64> = vm_avg.iter().map(|v| v * 1e-6).collect();
+    let sig_mpa: Vec<f64> = field
+        .averaged
+        .iter()
+        .flat_map(|s| s.map(|v| v * 1e-6))
+        .collect();
+    let mut set = vec![0.0; mesh.n_nodes()];
+    for &n in &loaded.nodes {
+        set[n] = 1.0;
+    }
+    for &n in &fixed.nodes {
+        set[n] = 2.0;
+    }
+    let near: Vec<f64> = away.iter().map(|a| if *a { 0.0 } else { 1.0 }).collect();
+    let cell_vm: Vec<f64> = field
+        .von_mises_element_max()
+        .iter()
+        .map(|v| v * 1e-6)
+        .collect();
+    write_vtu(
+        path,
+        mesh,
+        &[
+            VtuField {
+                name: "displacement_mm",
+                components: 3,
+                data: &u_mm,
+            },
+            VtuField {
+                name: "von_mises_averaged_MPa",
+                components: 1,
+                data: &vm_mpa,
+            },
+            VtuField {
+                name: "stress_averaged_MPa",
+                components: 6,
+                data: &sig_mpa,
+            },
+            VtuField {
+                name: "bore_set_1loaded_2fixed",
+                components: 1,
+                data: &set,
+            },
+            VtuField {
+                name: "near_fixed_band",
+                components: 1,
+                data: &near,
+            },
+        ],
+        &[VtuField {
+            name: "von_mises_max_unaveraged_MPa",
+            components: 1,
+            data: &cell_vm,
+        }],
+    )
+}

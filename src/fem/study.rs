@@ -1,0 +1,158 @@
+//! Mesh refinement study: the rod analysed at several element sizes, to show which stress measure
+//! converges (the maximum away from the fixed bore) and which does not (the peak at the fixed edge,
+//! a singularity).
+
+use std::path::Path;
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+
+use super::bores::BoreSpec;
+use super::error::{FemError, Result};
+use super::material::Material;
+use super::mesh::{TetMesh, mesh_stl};
+use super::rod::{LoadCaseResult, RodOptions, solve_rod};
+use super::statics::Timings;
+
+/// The stress measures of one case at one size.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct CaseMeasures {
+    /// Max element-nodal von Mises, MPa.
+    pub max_unaveraged_mpa: f64,
+    /// Max nodally averaged von Mises, MPa.
+    pub max_averaged_mpa: f64,
+    /// Max nodally averaged von Mises outside the band around the fixed bore, MPa.
+    pub max_away_from_fixed_mpa: f64,
+    /// Max displacement, mm.
+    pub max_displacement_mm: f64,
+}
+
+impl From<&LoadCaseResult> for CaseMeasures {
+    fn from(c: &LoadCaseResult) -> Self {
+        CaseMeasures {
+            max_unaveraged_mpa: c.max_von_mises_unaveraged_mpa,
+            max_averaged_mpa: c.max_von_mises_averaged_mpa,
+            max_away_from_fixed_mpa: c.max_von_mises_away_from_fixed_mpa,
+            max_displacement_mm: c.max_displacement_mm,
+        }
+    }
+}
+
+/// One size of a refinement study.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RefinementLevel {
+    /// Target element size, mm.
+    pub size_mm: f64,
+    /// Mean element edge length of the mesh, mm.
+    pub mean_edge_mm: f64,
+    /// Nodes.
+    pub nodes: usize,
+    /// Elements.
+    pub elements: usize,
+    /// DOFs.
+    pub dofs: usize,
+    /// Stored entries of the Cholesky factor.
+    pub nnz_l: usize,
+    /// Case F_x.
+    pub fx: CaseMeasures,
+    /// Case F_y.
+    pub fy: CaseMeasures,
+    /// Meshing time, s (0 when the mesh was given).
+    pub mesh_s: f64,
+    /// Analysis times.
+    pub timings: Timings,
+    /// Analysis wall time, s.
+    pub solve_total_s: f64,
+}
+
+/// A refinement study.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RefinementStudy {
+    /// Force magnitude, N.
+    pub force_n: f64,
+    /// Band around the fixed bore excluded from the "away" measure, the same at every size, mm.
+    pub fixed_band_mm: f64,
+    /// Levels, in the order of the sizes given.
+    pub levels: Vec<RefinementLevel>,
+}
+
+/// Runs the rod analysis at each size with meshes from `mesher(size_mm) -> (mesh, seconds)`.
+/// The band around the fixed bore is `options.fixed_band_m`, else the largest size, at every level.
+pub fn refinement_study(
+    sizes_mm: &[f64],
+    mut mesher: impl FnMut(f64) -> Result<(TetMesh, f64)>,
+    material: &Material,
+    bores: &BoreSpec,
+    force_n: f64,
+    options: &RodOptions,
+) -> Result<RefinementStudy> {
+    if sizes_mm.is_empty() || sizes_mm.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
+        return Err(FemError::InvalidInput(format!(
+            "refinement sizes must be > 0 mm, got {sizes_mm:?}"
+        )));
+    }
+    let band = options
+        .fixed_band_m
+        .unwrap_or(sizes_mm.iter().copied().fold(0.0, f64::max) * 1e-3);
+    let opts = RodOptions {
+        fixed_band_m: Some(band),
+        ..options.clone()
+    };
+    let mut levels = Vec::new();
+    for &size in sizes_mm {
+        let (mesh, mesh_s) = mesher(size)?;
+        let t = Instant::now();
+        let r = solve_rod(&mesh, material, bores, force_n, &opts)?;
+        levels.push(RefinementLevel {
+            size_mm: size,
+            mean_edge_mm: r.mean_edge_mm,
+            nodes: r.nodes,
+            elements: r.elements,
+            dofs: r.dofs,
+            nnz_l: r.nnz_l,
+            fx: (&r.fx).into(),
+            fy: (&r.fy).into(),
+            mesh_s,
+            timings: r.timings,
+            solve_total_s: t.elapsed().as_secs_f64(),
+        });
+    }
+    Ok(RefinementStudy {
+        force_n,
+        fixed_band_mm: band * 1e3,
+        levels,
+    })
+}
+
+/// [`refinement_study`] with meshes made from `stl` by `pipeline/mesh_rod.py` (into `out_dir/<size>mm/`).
+#[allow(clippy::too_many_arguments)]
+pub fn refinement_study_stl(
+    python: &Path,
+    script: &Path,
+    stl: &Path,
+    sizes_mm: &[f64],
+    out_dir: &Path,
+    material: &Material,
+    bores: &BoreSpec,
+    force_n: f64,
+    options: &RodOptions,
+) -> Result<RefinementStudy> {
+    refinement_study(
+        sizes_mm,
+        |size| {
+            let t = Instant::now();
+            let m = mesh_stl(
+                python,
+                script,
+                stl,
+                size,
+                &out_dir.join(format!("{size}mm")),
+            )?;
+            Ok((m.mesh, t.elapsed().as_secs_f64()))
+        },
+        material,
+        bores,
+        force_n,
+        options,
+    )
+}
