@@ -21,6 +21,20 @@ pub enum BenchCommand {
         #[arg(long)]
         json: bool,
     },
+    /// Stage 3: mesh, assembly, symbolic analysis, factorisation, solve and stress times and
+    /// peak memory per design at one mesh size (each design in its own process for the memory).
+    Fem {
+        /// STL designs (default: every design in designs/).
+        designs: Vec<PathBuf>,
+        /// Element size [mm].
+        #[arg(long, default_value_t = 5.0)]
+        size: f64,
+        /// Load of both cases [N] (default: each design's peak pin force).
+        #[arg(long)]
+        force: Option<f64>,
+        #[arg(long)]
+        json: bool,
+    },
     /// Stage 2: the full driven scene (5000 steps) through the multibody core against the
     /// closed form, for one design (default: the thesis' original rod, ch. 3 data).
     Dynamics {
@@ -68,6 +82,12 @@ pub fn run(command: BenchCommand) -> Result<i32> {
             );
             Ok(0)
         }
+        BenchCommand::Fem {
+            designs,
+            size,
+            force,
+            json,
+        } => bench_fem(designs, size, force, json),
         BenchCommand::Dynamics {
             design,
             repeats,
@@ -120,4 +140,70 @@ pub fn run(command: BenchCommand) -> Result<i32> {
             Ok(0)
         }
     }
+}
+
+/// Runs `rodstudy fem --json` for each design in a child process (so VmHWM is that design's own
+/// peak memory) and tabulates the stage times.
+fn bench_fem(designs: Vec<PathBuf>, size: f64, force: Option<f64>, json: bool) -> Result<i32> {
+    let files = if designs.is_empty() {
+        crate::geometry::design::find_stl_files(&[PathBuf::from("designs")])?
+    } else {
+        crate::geometry::design::find_stl_files(&designs)?
+    };
+    let exe = std::env::current_exe()?;
+    let mut rows = Vec::new();
+    for stl in &files {
+        let out = tempfile::tempdir()?;
+        let mut cmd = std::process::Command::new(&exe);
+        cmd.arg("fem")
+            .arg(stl)
+            .args(["--json", "--size", &size.to_string(), "--out"])
+            .arg(out.path());
+        if let Some(f) = force {
+            cmd.args(["--force", &f.to_string()]);
+        }
+        let output = cmd.output()?;
+        if !output.status.success() {
+            anyhow::bail!(
+                "{}: {}",
+                stl.display(),
+                String::from_utf8_lossy(&output.stderr).trim()
+            );
+        }
+        let v: serde_json::Value = serde_json::from_slice(&output.stdout)?;
+        rows.push((stl.clone(), v));
+    }
+    if json {
+        let all: Vec<&serde_json::Value> = rows.iter().map(|r| &r.1).collect();
+        println!("{}", serde_json::to_string_pretty(&all)?);
+        return Ok(0);
+    }
+    println!("FEM at {size} mm, each design in its own process\n");
+    println!(
+        "| design | DOFs | elements | mesh [s] | assembly [s] | symbolic [s] | factorisation [s] | solve, 2 cases [s] | stress [s] | nnz(L) | peak memory [MB] |\n|---|---|---|---|---|---|---|---|---|---|---|"
+    );
+    for (stl, v) in &rows {
+        let f = &v["fem"];
+        let t = &f["timings"];
+        let s = |x: &serde_json::Value| x.as_f64().map_or("—".into(), |v| format!("{v:.2}"));
+        println!(
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            stl.file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default(),
+            f["dofs"],
+            f["elements"],
+            s(&v["mesh"]["seconds"]),
+            s(&t["assembly_s"]),
+            s(&t["symbolic_s"]),
+            s(&t["factorisation_s"]),
+            s(&t["solve_s"]),
+            s(&t["stress_s"]),
+            f["nnz_l"],
+            v["peak_memory_mb"]
+                .as_f64()
+                .map_or("—".into(), |m| format!("{m:.0}"))
+        );
+    }
+    Ok(0)
 }

@@ -96,6 +96,8 @@ struct FemJson<'a> {
     mesh: &'a crate::study::fem_stage::MeshSummary,
     criterion: &'a crate::study::fem_stage::StressVerdict,
     fem: &'a crate::fem::FemResult,
+    /// Peak resident memory of this process so far (VmHWM) [MB].
+    peak_memory_mb: Option<f64>,
 }
 
 impl<'a> From<&'a DesignFem> for FemJson<'a> {
@@ -110,6 +112,7 @@ impl<'a> From<&'a DesignFem> for FemJson<'a> {
             mesh: &d.mesh,
             criterion: &d.criterion,
             fem: &d.fem,
+            peak_memory_mb: crate::fem::bench::peak_memory_mb(),
         }
     }
 }
