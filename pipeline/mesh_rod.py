@@ -3,7 +3,7 @@
 
 Two commands, both ending with one line of JSON on standard output (progress goes to standard error):
 
-  mesh_rod.py mesh STL OUT_DIR [--size 5] [--curved] [--name NAME]
+  mesh_rod.py mesh STL OUT_DIR [--size 5] [--curved] [--name NAME] [--size-field FILE] [--geometry FILE]
       STL as a CAD export comes (millimetres, triangle soup) -> gmsh: merge, classify the surface
       triangles into patches (`classifySurfaces`, angles in radians), `createGeometry` (reparametrised
       discrete surfaces), surface loop, volume, 3D mesh at the target size, second order (10-node
@@ -18,6 +18,17 @@ Two commands, both ending with one line of JSON on standard output (progress goe
       by the very same code path as `convert`.
       JSON: paths, node and element counts, min/mean scaled Jacobian and SICN (gmsh
       `getElementQualities` "minSJ" / "minSICN"), whether elements are curved, timings.
+
+      --size-field FILE: a local element size map for adaptive refinement, as gmsh's
+      `examples/api/adapt_mesh.py` does it: a list-based post-processing view of scalar tetrahedra
+      ("SS": per tetrahedron the x, y, z of its 4 corners, then the 4 sizes; FILE holds them as raw
+      little-endian float64, 16 per tetrahedron) used as a `PostView` background field. --size is
+      then the cap. With a size field, sizes come from it alone: `MeshSizeFromPoints`,
+      `MeshSizeFromCurvature` and `MeshSizeExtendFromBoundary` are off.
+      --geometry FILE: the classified surface (gmsh's `classifySurfaces` result, MSH) is written to
+      FILE (with FILE.json naming the classification setting) on first use and read back on later
+      calls, so an adaptive sequence classifies the STL once (classification is most of the time of
+      a coarse mesh).
 
       Second-order nodes are placed at the straight edge midpoints (`Mesh.SecondOrderLinear = 1`):
       snapping them onto a surface reconstructed from an STL (a faceted surface, so nothing is gained in
@@ -78,10 +89,10 @@ def log(msg: str) -> None:
 # gmsh meshing
 # ---------------------------------------------------------------------------------------------
 
-def gmsh_options(size_mm: float, curved: bool) -> dict:
+def gmsh_options(size_mm: float, curved: bool, size_field: bool = False) -> dict:
     """Every option that influences the mesh, fixed here so that results do not depend on defaults or
     on a user's gmsh configuration files (which are not read)."""
-    return {
+    opts = {
         "General.Terminal": 0,
         "General.NumThreads": 1,
         "Mesh.Algorithm": 6,  # Frontal-Delaunay (2D)
@@ -106,27 +117,58 @@ def gmsh_options(size_mm: float, curved: bool) -> dict:
         "Mesh.Binary": 0,
         "Mesh.SaveAll": 0,
     }
+    if size_field:
+        # the background field alone sets the sizes (gmsh's examples/api/adapt_mesh.py)
+        opts["Mesh.MeshSizeExtendFromBoundary"] = 0
+    return opts
+
+
+def add_size_field(path: pathlib.Path) -> int:
+    """The size map of `path` (raw float64, 16 per tetrahedron: x0..x3, y0..y3, z0..z3, s0..s3) as a
+    list-based view and a PostView background field."""
+    import gmsh
+
+    data = np.fromfile(str(path), dtype="<f8")
+    if data.size == 0 or data.size % 16:
+        raise SystemExit(f"mesh_rod: {path}: a size field holds 16 float64 per tetrahedron, got {data.size} values")
+    sizes = data.reshape(-1, 16)[:, 12:]
+    if not (np.isfinite(data).all() and (sizes > 0).all()):
+        raise SystemExit(f"mesh_rod: {path}: sizes must be finite and > 0")
+    view = gmsh.view.add("size field")
+    gmsh.view.addListData(view, "SS", data.size // 16, data.tolist())
+    field = gmsh.model.mesh.field.add("PostView")
+    gmsh.model.mesh.field.setNumber(field, "ViewTag", view)
+    gmsh.model.mesh.field.setAsBackgroundMesh(field)
+    return data.size // 16
 
 
 def gmsh_volume_mesh(stl: pathlib.Path, size_mm: float, curved: bool, angle_deg: float,
-                     curve_angle_deg: float, msh_out: pathlib.Path) -> dict:
+                     curve_angle_deg: float, msh_out: pathlib.Path, size_field: pathlib.Path | None = None,
+                     geometry_in: pathlib.Path | None = None,
+                     geometry_out: pathlib.Path | None = None) -> dict:
     import gmsh
 
     t0 = time.perf_counter()
     gmsh.initialize(["mesh_rod"], readConfigFiles=False)
     try:
-        for k, v in gmsh_options(size_mm, curved).items():
+        for k, v in gmsh_options(size_mm, curved, size_field is not None).items():
             gmsh.option.setNumber(k, v)
         gmsh.model.add("rod")
-        gmsh.merge(str(stl))
-        # Patches from the triangle soup: split at sharp edges (angle in radians), keep boundaries,
-        # make each patch parametrisable so that it can be remeshed at the target size.
-        gmsh.model.mesh.classifySurfaces(math.radians(angle_deg), True, True, math.radians(curve_angle_deg))
+        if geometry_in is not None:
+            gmsh.merge(str(geometry_in))
+        else:
+            gmsh.merge(str(stl))
+            # Patches from the triangle soup: split at sharp edges (angle in radians), keep
+            # boundaries, make each patch parametrisable so that it can be remeshed at the target size.
+            gmsh.model.mesh.classifySurfaces(math.radians(angle_deg), True, True, math.radians(curve_angle_deg))
+            if geometry_out is not None:
+                gmsh.write(str(geometry_out))
         gmsh.model.mesh.createGeometry()
         surfaces = [tag for _, tag in gmsh.model.getEntities(2)]
         loop = gmsh.model.geo.addSurfaceLoop(surfaces)
         gmsh.model.geo.addVolume([loop])
         gmsh.model.geo.synchronize()
+        size_field_tets = add_size_field(size_field) if size_field is not None else 0
         t1 = time.perf_counter()
         gmsh.model.mesh.generate(3)
         t2 = time.perf_counter()
@@ -148,6 +190,8 @@ def gmsh_volume_mesh(stl: pathlib.Path, size_mm: float, curved: bool, angle_deg:
             "mean_sicn": float(min_sicn.mean()),
             "elements_sicn_below_0.1": int((min_sicn < 0.1).sum()),
             "surface_patches": len(surfaces),
+            "size_field_tetrahedra": size_field_tets,
+            "geometry_reused": geometry_in is not None,
             "seconds_geometry": t1 - t0,
             "seconds_mesh": t2 - t1,
             "gmsh_version": gmsh.option.getString("General.Version"),
@@ -157,12 +201,17 @@ def gmsh_volume_mesh(stl: pathlib.Path, size_mm: float, curved: bool, angle_deg:
 
 
 def run_attempt(stl: pathlib.Path, size: float, curved: bool, angle: float, curve_angle: float,
-                msh: pathlib.Path) -> tuple[dict | None, str]:
+                msh: pathlib.Path, size_field=None, geometry_in=None,
+                geometry_out=None) -> tuple[dict | None, str]:
     """One gmsh run in a child process (gmsh can crash on bad reparametrisations)."""
     cmd = [sys.executable, str(pathlib.Path(__file__).resolve()), "_attempt", str(stl), str(msh),
            "--size", repr(size), "--angle", repr(angle), "--curve-angle", repr(curve_angle)]
     if curved:
         cmd.append("--curved")
+    for flag, value in (("--size-field", size_field), ("--geometry-in", geometry_in),
+                        ("--geometry-out", geometry_out)):
+        if value is not None:
+            cmd += [flag, str(value)]
     run = subprocess.run(cmd, capture_output=True, text=True)
     if run.returncode == 0:
         return json.loads(run.stdout.strip().splitlines()[-1]), ""
@@ -185,24 +234,41 @@ def cmd_mesh(args) -> dict:
     msh = out_dir / f"{name}.msh"
     rodmesh = out_dir / f"{name}.rodmesh"
     t0 = time.perf_counter()
+    size_field = pathlib.Path(args.size_field) if args.size_field else None
+    if size_field is not None and not size_field.is_file():
+        raise SystemExit(f"mesh_rod: no such size field file: {size_field}")
+    geometry = pathlib.Path(args.geometry) if args.geometry else None
+    meta = geometry.with_name(geometry.name + ".json") if geometry else None
     ladder = [(args.angle, args.curve_angle)] if args.angle is not None or args.curve_angle is not None else LADDER
     ladder = [(a if a is not None else LADDER[0][0], c if c is not None else LADDER[0][1]) for a, c in ladder]
+    cached = None
+    if geometry is not None and geometry.is_file() and meta.is_file():
+        cached = json.loads(meta.read_text())
+        ladder = [(cached["classify_angle_deg"], cached["curve_angle_deg"])] + \
+            [r for r in ladder if r != (cached["classify_angle_deg"], cached["curve_angle_deg"])]
     failed = []
     info = None
-    for angle, curve_angle in ladder:
+    for rung, (angle, curve_angle) in enumerate(ladder):
+        reuse = cached is not None and rung == 0
         log(f"{stl.name}: meshing at {args.size} mm (classification {angle:g} deg, curves {curve_angle:g} deg)"
+            + (", size field" if size_field else "") + (", classified surface reused" if reuse else "")
             + (", curved attempt" if args.curved else ""))
+        geo_in = geometry if reuse else None
+        geo_out = geometry.with_name(geometry.name + ".tmp.msh") if geometry is not None and not reuse else None
         curved = False
         if args.curved:
-            info, why = run_attempt(stl, args.size, True, angle, curve_angle, msh)
+            info, why = run_attempt(stl, args.size, True, angle, curve_angle, msh, size_field, geo_in, geo_out)
             curved = info is not None and info["min_scaled_jacobian"] > 0.0
             if info is not None and not curved:
                 log(f"curved mesh has min scaled Jacobian {info['min_scaled_jacobian']:.3g} <= 0: "
                     "falling back to straight-sided elements")
         if not curved:
-            info, why = run_attempt(stl, args.size, False, angle, curve_angle, msh)
+            info, why = run_attempt(stl, args.size, False, angle, curve_angle, msh, size_field, geo_in, geo_out)
         if info is not None:
             info.update({"classify_angle_deg": angle, "curve_angle_deg": curve_angle, "curved": curved})
+            if geo_out is not None and geo_out.is_file():
+                geo_out.replace(geometry)
+                meta.write_text(json.dumps({"classify_angle_deg": angle, "curve_angle_deg": curve_angle}))
             break
         log(f"  failed: {why}")
         failed.append({"classify_angle_deg": angle, "curve_angle_deg": curve_angle, "error": why})
@@ -229,8 +295,10 @@ def cmd_mesh(args) -> dict:
 
 def cmd_attempt(args) -> dict:
     """Internal: one gmsh run, writing the .msh; used by `mesh` in a child process."""
+    path = lambda v: pathlib.Path(v) if v else None  # noqa: E731
     return gmsh_volume_mesh(pathlib.Path(args.stl), args.size, args.curved, args.angle, args.curve_angle,
-                            pathlib.Path(args.msh))
+                            pathlib.Path(args.msh), path(args.size_field), path(args.geometry_in),
+                            path(args.geometry_out))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -319,6 +387,8 @@ def main(argv=None) -> int:
                     help="classifySurfaces: dihedral angle (degrees) splitting patches (default: the ladder)")
     pm.add_argument("--curve-angle", type=float,
                     help="classifySurfaces: angle (degrees) splitting curves (default: the ladder)")
+    pm.add_argument("--size-field", help="local size map: raw float64, 16 per tetrahedron (see above)")
+    pm.add_argument("--geometry", help="cache of the classified surface (written once, then reused)")
     pa = sub.add_parser("_attempt", help=argparse.SUPPRESS)
     pa.add_argument("stl")
     pa.add_argument("msh")
@@ -326,6 +396,9 @@ def main(argv=None) -> int:
     pa.add_argument("--angle", type=float, required=True)
     pa.add_argument("--curve-angle", type=float, required=True)
     pa.add_argument("--curved", action="store_true")
+    pa.add_argument("--size-field")
+    pa.add_argument("--geometry-in")
+    pa.add_argument("--geometry-out")
     pc = sub.add_parser("convert", help="any meshio volume mesh -> .rodmesh")
     pc.add_argument("input")
     pc.add_argument("output")

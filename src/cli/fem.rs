@@ -9,7 +9,7 @@ use crate::mechanism::Method;
 use crate::python_env::{pipeline_script, python};
 use crate::study::config::StudyConfig;
 use crate::study::dynamics_stage::dynamics_of_design;
-use crate::study::fem_stage::{DesignFem, MESHER, fem_of_design};
+use crate::study::fem_stage::{DesignFem, MESHER, MeshMode, fem_of_design};
 use anyhow::{Result, bail};
 use clap::Args;
 use std::path::PathBuf;
@@ -22,9 +22,14 @@ pub struct FemArgs {
     /// as it is, instead of meshing the STL.
     #[arg(long)]
     mesh: Option<PathBuf>,
-    /// Target element size [mm] (default 5, or `fem.mesh_size_mm` of the configuration).
-    #[arg(long)]
+    /// One fixed mesh of this element size [mm] (the thesis' setting is 5), instead of adaptive
+    /// refinement.
+    #[arg(long, conflicts_with = "target_error")]
     size: Option<f64>,
+    /// Refine adaptively until the estimated relative error of each case's judged peak is at
+    /// most this (default: `fem.target_error` of the configuration, 0.03).
+    #[arg(long)]
+    target_error: Option<f64>,
     /// Load magnitude [N] of both cases (default: the design's peak pin force).
     #[arg(long)]
     force: Option<f64>,
@@ -45,8 +50,22 @@ pub struct FemArgs {
 pub fn run(args: FemArgs) -> Result<i32> {
     let mut config = StudyConfig::load(args.config.as_deref())?;
     if let Some(size) = args.size {
+        if !(size.is_finite() && size > 0.0) {
+            bail!("--size must be a positive number of mm, got {size}");
+        }
         config.fem.mesh_size_mm = size;
     }
+    if let Some(t) = args.target_error {
+        if !(t.is_finite() && t > 0.0 && t < 1.0) {
+            bail!("--target-error must lie in (0, 1), got {t}");
+        }
+        config.fem.target_error = t;
+    }
+    let mode = match (&args.mesh, args.size) {
+        (Some(file), _) => MeshMode::User(file.clone()),
+        (None, Some(size)) => MeshMode::Fixed(size),
+        (None, None) => MeshMode::from_config(&config),
+    };
     let force = match args.force {
         Some(f) if f.is_finite() && f > 0.0 => f,
         Some(f) => bail!("--force must be a positive number of newtons, got {f}"),
@@ -74,7 +93,7 @@ pub fn run(args: FemArgs) -> Result<i32> {
         &config,
         &args.out.join("mesh"),
         &args.out,
-        args.mesh.as_deref(),
+        &mode,
     )?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&FemJson::from(&result))?);
@@ -130,19 +149,50 @@ fn print_result(d: &DesignFem) {
         f.fixed_bore.radius_mm
     );
     println!(
-        "\n| case | max von Mises unaveraged [MPa] | averaged [MPa] | away from fixed bore [MPa] | max displacement [mm] | resultant error | reaction balance |\n|---|---|---|---|---|---|---|"
+        "\n| case | max von Mises unaveraged [MPa] | averaged [MPa] | away from fixed bore [MPa] (judged) | max displacement [mm] | resultant error | reaction balance |\n|---|---|---|---|---|---|---|"
     );
     for c in [&f.fx, &f.fy] {
         println!(
-            "| {} | {:.2} | {:.2} | {:.2} | {:.4} | {:.1e} | {:.1e} |",
+            "| {} | {:.2} | {:.2} | {:.2} ± {:.1} % | {:.4} | {:.1e} | {:.1e} |",
             c.name,
             c.max_von_mises_unaveraged_mpa,
             c.max_von_mises_averaged_mpa,
             c.max_von_mises_away_from_fixed_mpa,
+            100.0 * c.estimated_error_rel,
             c.max_displacement_mm,
             c.resultant_error_rel,
             c.reaction_balance_rel
         );
+    }
+    if let Some(a) = &d.mesh.adaptive {
+        println!(
+            "\nadaptive refinement to an estimated error of {:.1} % ({:?} after {} meshes, {:.1} s meshing); the size floor is {} (median {:.2} mm)",
+            100.0 * a.target_error_rel,
+            a.stop,
+            a.iterations,
+            d.mesh.seconds,
+            a.floor,
+            a.facet_spacing_median_mm
+        );
+        println!(
+            "\n| case | iteration | elements | DOFs | peak [MPa] | size at peak [mm] | order | estimated error | wall [s] |\n|---|---|---|---|---|---|---|---|---|"
+        );
+        for c in [&f.fx, &f.fy] {
+            for s in &c.adaptive {
+                println!(
+                    "| {} | {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} % | {:.1} |",
+                    c.name,
+                    s.iteration,
+                    s.elements,
+                    s.dofs,
+                    s.peak_mpa,
+                    s.size_at_peak_mm,
+                    s.order,
+                    100.0 * s.estimated_error_rel,
+                    s.seconds
+                );
+            }
+        }
     }
     let t = &f.timings;
     println!(
@@ -199,11 +249,11 @@ fn refine(args: &FemArgs, config: &StudyConfig, force: f64, sizes: &[f64]) -> Re
         force
     );
     println!(
-        "| size [mm] | elements | DOFs | F_x unaveraged / averaged / away [MPa] | F_y unaveraged / averaged / away [MPa] | F_y max displ. [mm] | mesh [s] | solve [s] |\n|---|---|---|---|---|---|---|---|"
+        "| size [mm] | elements | DOFs | F_x unaveraged / averaged / away [MPa] | F_y unaveraged / averaged / away [MPa] | F_y max displ. [mm] | F_x / F_y recovered peak [MPa] | F_x / F_y est. error | F_x / F_y bound at peak | F_x / F_y energy error | mesh [s] | solve [s] |\n|---|---|---|---|---|---|---|---|---|---|---|---|"
     );
     for l in &study.levels {
         println!(
-            "| {} | {} | {} | {:.1} / {:.1} / {:.1} | {:.1} / {:.1} / {:.1} | {:.4} | {:.1} | {:.2} |",
+            "| {} | {} | {} | {:.1} / {:.1} / {:.1} | {:.1} / {:.1} / {:.1} | {:.4} | {:.1} / {:.1} | {:.3} / {:.3} | {:.3} / {:.3} | {:.3} / {:.3} | {:.1} | {:.2} |",
             l.size_mm,
             l.elements,
             l.dofs,
@@ -214,6 +264,14 @@ fn refine(args: &FemArgs, config: &StudyConfig, force: f64, sizes: &[f64]) -> Re
             l.fy.max_averaged_mpa,
             l.fy.max_away_from_fixed_mpa,
             l.fy.max_displacement_mm,
+            l.fx.error_estimate.recovered_peak_mpa,
+            l.fy.error_estimate.recovered_peak_mpa,
+            l.fx.estimated_error_rel,
+            l.fy.estimated_error_rel,
+            l.fx.error_estimate.peak_node_bound_rel,
+            l.fy.error_estimate.peak_node_bound_rel,
+            l.fx.error_estimate.energy_error_rel,
+            l.fy.error_estimate.energy_error_rel,
             l.mesh_s,
             l.solve_total_s
         );

@@ -20,16 +20,20 @@
 //! *The Finite Element Method* (isoparametric elements, stiffness, quadrature); P. Keast, *Moderate
 //! degree tetrahedral quadrature formulas*, CMAME 55 (1986); D. A. Dunavant, IJNME 21 (1985).
 
+pub mod adapt;
 pub mod assembly;
 pub mod bench;
 pub mod bores;
 pub mod boundary;
 pub mod element;
 pub mod error;
+pub mod estimate;
+pub mod facets;
 pub mod load;
 pub mod material;
 pub mod mesh;
 pub mod quadrature;
+pub mod recovery;
 pub mod rod;
 pub mod shape;
 pub mod solver;

@@ -16,15 +16,23 @@ use super::bores::{BoreSpec, BoreSurface, find_bores};
 use super::boundary::{boundary_faces, cross, norm};
 use super::element::QuadratureChoice;
 use super::error::{FemError, Result};
+use super::estimate::{ErrorEstimate, EstimateSummary, estimate_error};
 use super::load::uniform_traction_with_resultant;
 use super::material::Material;
 use super::mesh::TetMesh;
+use super::recovery::recover_stress;
 use super::statics::{StaticProblem, Timings, solve_static};
 use super::stress::{
-    StressField, displacement_magnitudes, nodes_away_from, peak_nodal, peak_unaveraged,
-    stress_field,
+    StressField, displacement_magnitudes, nodes_away_from, nodes_away_from_segments, peak_nodal,
+    peak_unaveraged, stress_field,
 };
 use super::vtu::{VtuField, write_vtu};
+
+/// The default band around the fixed bore excluded from the judged stress measure: 6 mm.
+pub const DEFAULT_FIXED_BAND_M: f64 = 6e-3;
+
+/// The default band around sharp re-entrant edges left out of the judged peak: 3 mm.
+pub const DEFAULT_SINGULAR_BAND_M: f64 = 3e-3;
 
 /// Options of [`solve_rod`].
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
@@ -32,8 +40,17 @@ pub struct RodOptions {
     /// Element quadrature (default: 4-point for straight, 14-point for curved elements).
     pub quadrature: QuadratureChoice,
     /// Width of the band around the fixed bore excluded from the "away from fixed" measure, m.
-    /// `None`: the mesh's mean edge length (one element size).
+    /// `None`: [`DEFAULT_FIXED_BAND_M`], a fixed physical distance (not a number of elements, so
+    /// that refinement does not move the band towards the singular edge).
     pub fixed_band_m: Option<f64>,
+    /// Sharp re-entrant edges of the geometry (segments, m): stress singularities, left out of
+    /// the judged peak like the fixed bore ([`super::facets::reentrant_edges`]).
+    #[serde(default)]
+    pub singular_edges_m: Vec<[[f64; 3]; 2]>,
+    /// Band around the singular edges left out of the judged peak, m (`None`:
+    /// [`DEFAULT_SINGULAR_BAND_M`]).
+    #[serde(default)]
+    pub singular_band_m: Option<f64>,
     /// Write ParaView files `<vtu_dir>/<vtu_stem>_fx.vtu` and `_fy.vtu` when set.
     pub vtu_dir: Option<PathBuf>,
     /// Base name of the VTU files (default "rod").
@@ -79,8 +96,40 @@ pub struct LoadCaseResult {
     pub reaction_balance_rel: f64,
     /// ‖K u − f‖ / ‖f‖ over the free DOFs.
     pub solve_residual_rel: f64,
+    /// Estimated relative error of `max_von_mises_away_from_fixed_mpa` (the judged peak): the
+    /// recovery estimate on one mesh, the goal-oriented one over an adaptive sequence (see
+    /// `error_estimate` and `adaptive`).
+    pub estimated_error_rel: f64,
+    /// The recovery-based (Zienkiewicz–Zhu) estimates on this mesh.
+    pub error_estimate: EstimateSummary,
+    /// The adaptive sequence that led to this mesh (empty for a fixed mesh).
+    #[serde(default)]
+    pub adaptive: Vec<AdaptiveStep>,
     /// ParaView file, if written.
     pub vtu: Option<PathBuf>,
+}
+
+/// One iteration of the adaptive loop, for one load case.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct AdaptiveStep {
+    /// 0 for the initial mesh.
+    pub iteration: usize,
+    /// Elements.
+    pub elements: usize,
+    /// DOFs.
+    pub dofs: usize,
+    /// The judged peak (max von Mises away from the fixed bore), MPa.
+    pub peak_mpa: f64,
+    /// Its estimated relative error at this iteration.
+    pub estimated_error_rel: f64,
+    /// Mean size of the elements at the peak, mm.
+    #[serde(default)]
+    pub size_at_peak_mm: f64,
+    /// The convergence order the estimate used (Richardson), 0 where it used recovery alone.
+    #[serde(default)]
+    pub order: f64,
+    /// Wall time of this iteration (mesh, solve, estimate), s.
+    pub seconds: f64,
 }
 
 /// A bore as found.
@@ -142,6 +191,12 @@ pub struct FemResult {
     pub mean_edge_mm: f64,
     /// Band around the fixed bore excluded from the "away" measure, mm.
     pub fixed_band_mm: f64,
+    /// Sharp re-entrant edges found in the geometry (singularities left out of the judged peak).
+    #[serde(default)]
+    pub singular_edges: usize,
+    /// Band around them excluded from the judged peak, mm.
+    #[serde(default)]
+    pub singular_band_mm: f64,
     /// The loaded bore.
     pub loaded_bore: BoreSummary,
     /// The fixed bore.
@@ -165,8 +220,13 @@ pub struct RodSolution {
     pub loaded: BoreSurface,
     /// Fixed bore B.
     pub fixed: BoreSurface,
-    /// Nodes outside the band around the fixed bore.
+    /// Nodes outside the bands around the fixed bore and the singular edges (the judged nodes).
     pub away_from_fixed: Vec<bool>,
+    /// Per node, the smallest element size adaptive refinement may ask for near a singularity
+    /// (a third of the band within twice the band of it, else 0), m.
+    pub singularity_floor_m: Vec<f64>,
+    /// Error estimates for fx and fy.
+    pub estimates: [ErrorEstimate; 2],
 }
 
 /// Analyses a rod: see the module documentation. `force_n` > 0 is the magnitude of both cases.
@@ -232,15 +292,36 @@ pub fn solve_rod_fields(
     let sol = solve_static(&problem)?;
 
     let t_stress = Instant::now();
-    let band = options
-        .fixed_band_m
-        .unwrap_or_else(|| mesh.mean_edge_length());
-    let away = nodes_away_from(mesh, &fixed.faces, band);
+    let band = options.fixed_band_m.unwrap_or(DEFAULT_FIXED_BAND_M);
+    let singular_band = options.singular_band_m.unwrap_or(DEFAULT_SINGULAR_BAND_M);
+    let away_fixed = nodes_away_from(mesh, &fixed.faces, band);
+    let away_edges = nodes_away_from_segments(mesh, &options.singular_edges_m, singular_band);
+    let away: Vec<bool> = away_fixed
+        .iter()
+        .zip(&away_edges)
+        .map(|(a, b)| *a && *b)
+        .collect();
+    // nodes close enough to a singularity that refinement would chase it: within twice a band
+    let near_fixed = nodes_away_from(mesh, &fixed.faces, 2.0 * band);
+    let near_edges = nodes_away_from_segments(mesh, &options.singular_edges_m, 2.0 * singular_band);
+    let chase_floor: Vec<f64> = near_fixed
+        .iter()
+        .zip(&near_edges)
+        .map(|(f, e)| match (f, e) {
+            (true, true) => 0.0,
+            (false, true) => band / 3.0,
+            (true, false) => singular_band / 3.0,
+            (false, false) => (band / 3.0).max(singular_band / 3.0),
+        })
+        .collect();
     let mut results = Vec::new();
     let mut fields = Vec::new();
+    let mut estimates = Vec::new();
     for (c, ((name, dir), load)) in cases.iter().zip(&loads).enumerate() {
         let u = &sol.displacements[c];
         let field = stress_field(mesh, material, u)?;
+        let recovered = recover_stress(mesh, material, u)?;
+        let estimate = estimate_error(mesh, material, u, &field, &recovered, &away)?;
         let vm_avg = field.von_mises_averaged();
         let un = peak_unaveraged(mesh, &field, None);
         let av = peak_nodal(mesh, &vm_avg, None);
@@ -259,16 +340,6 @@ pub fn solve_rod_fields(
                 load.resultant_n
             )));
         }
-        let vtu = match &options.vtu_dir {
-            Some(dir) => {
-                std::fs::create_dir_all(dir).map_err(|e| FemError::io(dir, e))?;
-                let stem = options.vtu_stem.as_deref().unwrap_or("rod");
-                let path = dir.join(format!("{stem}_{name}.vtu"));
-                write_case_vtu(&path, mesh, u, &field, &vm_avg, &fixed, &loaded, &away)?;
-                Some(path)
-            }
-            None => None,
-        };
         let mm = |p: [f64; 3]| p.map(|v| v * 1e3);
         results.push(LoadCaseResult {
             name: name.to_string(),
@@ -289,9 +360,13 @@ pub fn solve_rod_fields(
             reaction_n: reaction,
             reaction_balance_rel: bal,
             solve_residual_rel: sol.residual_rel[c],
-            vtu,
+            estimated_error_rel: estimate.summary.peak_error_rel,
+            error_estimate: estimate.summary,
+            adaptive: Vec::new(),
+            vtu: None,
         });
         fields.push(field);
+        estimates.push(estimate);
     }
     let mut timings = sol.timings;
     timings.stress_s = t_stress.elapsed().as_secs_f64();
@@ -311,6 +386,8 @@ pub fn solve_rod_fields(
         material: *material,
         mean_edge_mm: mesh.mean_edge_length() * 1e3,
         fixed_band_mm: band * 1e3,
+        singular_edges: options.singular_edges_m.len(),
+        singular_band_mm: singular_band * 1e3,
         loaded_bore: (&loaded).into(),
         fixed_bore: (&fixed).into(),
         timings,
@@ -323,14 +400,59 @@ pub fn solve_rod_fields(
     let [s0, s1]: [StressField; 2] = fields
         .try_into()
         .map_err(|_| FemError::Check("two cases".into()))?;
-    Ok(RodSolution {
+    let [e0, e1]: [ErrorEstimate; 2] = estimates
+        .try_into()
+        .map_err(|_| FemError::Check("two cases".into()))?;
+    let mut solution = RodSolution {
         result,
         displacements: [d0, d1],
         stresses: [s0, s1],
         loaded,
         fixed,
         away_from_fixed: away,
-    })
+        singularity_floor_m: chase_floor,
+        estimates: [e0, e1],
+    };
+    if let Some(dir) = &options.vtu_dir {
+        write_rod_vtus(
+            &mut solution,
+            mesh,
+            dir,
+            options.vtu_stem.as_deref().unwrap_or("rod"),
+        )?;
+    }
+    Ok(solution)
+}
+
+/// Writes the ParaView files `<dir>/<stem>_fx.vtu` and `_fy.vtu` of a solution on `mesh` and
+/// records their paths in its figures.
+pub fn write_rod_vtus(
+    solution: &mut RodSolution,
+    mesh: &TetMesh,
+    dir: &std::path::Path,
+    stem: &str,
+) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| FemError::io(dir, e))?;
+    for c in 0..2 {
+        let case = if c == 0 {
+            &mut solution.result.fx
+        } else {
+            &mut solution.result.fy
+        };
+        let path = dir.join(format!("{stem}_{}.vtu", case.name));
+        write_case_vtu(
+            &path,
+            mesh,
+            &solution.displacements[c],
+            &solution.stresses[c],
+            &solution.estimates[c],
+            &solution.fixed,
+            &solution.loaded,
+            &solution.away_from_fixed,
+        )?;
+        case.vtu = Some(path);
+    }
+    Ok(())
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -339,13 +461,27 @@ fn write_case_vtu(
     mesh: &TetMesh,
     u: &[f64],
     field: &StressField,
-    vm_avg: &[f64],
+    estimate: &ErrorEstimate,
     fixed: &BoreSurface,
     loaded: &BoreSurface,
     away: &[bool],
 ) -> Result<()> {
     let u_mm: Vec<f64> = u.iter().map(|v| v * 1e3).collect();
-    let vm_mpa: Vec<f64> = vm_avg.iter().map(|v| v * 1e-6).collect();
+    let vm_mpa: Vec<f64> = field
+        .von_mises_averaged()
+        .iter()
+        .map(|v| v * 1e-6)
+        .collect();
+    let vm_rec_mpa: Vec<f64> = estimate
+        .recovered_von_mises_pa
+        .iter()
+        .map(|v| v * 1e-6)
+        .collect();
+    let err_mpa: Vec<f64> = estimate
+        .element_von_mises_error_pa
+        .iter()
+        .map(|v| v * 1e-6)
+        .collect();
     let sig_mpa: Vec<f64> = field
         .averaged
         .iter()
@@ -379,6 +515,11 @@ fn write_case_vtu(
                 data: &vm_mpa,
             },
             VtuField {
+                name: "von_mises_recovered_MPa",
+                components: 1,
+                data: &vm_rec_mpa,
+            },
+            VtuField {
                 name: "stress_averaged_MPa",
                 components: 6,
                 data: &sig_mpa,
@@ -394,10 +535,17 @@ fn write_case_vtu(
                 data: &near,
             },
         ],
-        &[VtuField {
-            name: "von_mises_max_unaveraged_MPa",
-            components: 1,
-            data: &cell_vm,
-        }],
+        &[
+            VtuField {
+                name: "von_mises_max_unaveraged_MPa",
+                components: 1,
+                data: &cell_vm,
+            },
+            VtuField {
+                name: "von_mises_error_indicator_MPa",
+                components: 1,
+                data: &err_mpa,
+            },
+        ],
     )
 }

@@ -227,3 +227,51 @@ pub fn point_triangle_distance(p: [f64; 3], t: [[f64; 3]; 3]) -> f64 {
     let n = cross(ab, ac);
     dot(ap, n).abs() / dot(n, n).sqrt()
 }
+
+/// Per node: true when its distance to every segment of `segments` is at least `band` (m).
+pub fn nodes_away_from_segments(
+    mesh: &TetMesh,
+    segments: &[[[f64; 3]; 2]],
+    band: f64,
+) -> Vec<bool> {
+    if segments.is_empty() || band.is_nan() || band <= 0.0 {
+        return vec![true; mesh.n_nodes()];
+    }
+    let cell = |p: [f64; 3]| p.map(|v| (v / band).floor() as i64);
+    let mut grid: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
+    for (i, s) in segments.iter().enumerate() {
+        let lo: [f64; 3] = std::array::from_fn(|j| s[0][j].min(s[1][j]) - band);
+        let hi: [f64; 3] = std::array::from_fn(|j| s[0][j].max(s[1][j]) + band);
+        let (a, b) = (cell(lo), cell(hi));
+        for x in a[0]..=b[0] {
+            for y in a[1]..=b[1] {
+                for z in a[2]..=b[2] {
+                    grid.entry([x, y, z]).or_default().push(i);
+                }
+            }
+        }
+    }
+    mesh.nodes()
+        .par_iter()
+        .map(|p| {
+            grid.get(&cell(*p)).is_none_or(|list| {
+                list.iter()
+                    .all(|&i| point_segment_distance(*p, segments[i]) >= band)
+            })
+        })
+        .collect()
+}
+
+/// Distance from `p` to the segment `s`.
+pub fn point_segment_distance(p: [f64; 3], s: [[f64; 3]; 2]) -> f64 {
+    let d: [f64; 3] = std::array::from_fn(|j| s[1][j] - s[0][j]);
+    let w: [f64; 3] = std::array::from_fn(|j| p[j] - s[0][j]);
+    let dd = dot(d, d);
+    let t = if dd > 0.0 {
+        (dot(w, d) / dd).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let q: [f64; 3] = std::array::from_fn(|j| w[j] - t * d[j]);
+    dot(q, q).sqrt()
+}

@@ -25,6 +25,10 @@ pub struct CaseMeasures {
     pub max_away_from_fixed_mpa: f64,
     /// Max displacement, mm.
     pub max_displacement_mm: f64,
+    /// Estimated relative error of the "away" maximum.
+    pub estimated_error_rel: f64,
+    /// The recovery estimates on this mesh.
+    pub error_estimate: super::estimate::EstimateSummary,
 }
 
 impl From<&LoadCaseResult> for CaseMeasures {
@@ -34,6 +38,8 @@ impl From<&LoadCaseResult> for CaseMeasures {
             max_averaged_mpa: c.max_von_mises_averaged_mpa,
             max_away_from_fixed_mpa: c.max_von_mises_away_from_fixed_mpa,
             max_displacement_mm: c.max_displacement_mm,
+            estimated_error_rel: c.estimated_error_rel,
+            error_estimate: c.error_estimate,
         }
     }
 }

@@ -9,13 +9,22 @@
 //! gravity = true
 //!
 //! [fem]               # SPEC Stage 3
-//! mesh_size_mm = 5.0
+//! target_error = 0.03          # adaptive refinement to this estimated error of the peak; 0: one
+//!                              # fixed mesh of mesh_size_mm
+//! mesh_size_mm = 5.0           # the fixed mesh's size (the thesis' 5 mm)
+//! initial_size_mm = 8.0        # adaptive: first mesh (uniform) and largest size
+//! min_size_mm = 0.3            # adaptive: smallest size (the STL's facet spacing floors it too)
+//! max_iterations = 5           # adaptive: most meshes
+//! max_dofs = 400000            # adaptive: largest mesh
+//! fixed_band_mm = 6.0          # band around the fixed bore left out of the judged peak
+//! singular_band_mm = 3.0       # band around sharp re-entrant edges left out of it
 //! youngs_modulus_pa = 210e9
 //! poisson_ratio = 0.3
 //!
 //! [criterion]         # the ranking's stress criterion
 //! yield_mpa = 355.0
 //! safety_factor = 1.5
+//! with_error = false  # judge the peak plus its estimated error instead of the peak
 //! ```
 
 use anyhow::{Context, Result, bail};
@@ -47,7 +56,23 @@ impl Default for DrivenConfig {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct FemConfig {
+    /// Target estimated relative error of the judged peak (adaptive refinement); 0 = one fixed
+    /// mesh of `mesh_size_mm`.
+    pub target_error: f64,
+    /// Element size of the fixed mesh, mm.
     pub mesh_size_mm: f64,
+    /// Adaptive: uniform size of the first mesh and the largest size, mm.
+    pub initial_size_mm: f64,
+    /// Adaptive: smallest size, mm.
+    pub min_size_mm: f64,
+    /// Adaptive: most meshes in the sequence.
+    pub max_iterations: usize,
+    /// Adaptive: most DOFs of a mesh.
+    pub max_dofs: usize,
+    /// Band around the fixed bore excluded from the judged peak, mm.
+    pub fixed_band_mm: f64,
+    /// Band around sharp re-entrant edges (singularities) excluded from the judged peak, mm.
+    pub singular_band_mm: f64,
     pub youngs_modulus_pa: f64,
     pub poisson_ratio: f64,
 }
@@ -55,10 +80,24 @@ pub struct FemConfig {
 impl Default for FemConfig {
     fn default() -> Self {
         FemConfig {
+            target_error: 0.03,
             mesh_size_mm: 5.0,
+            initial_size_mm: 8.0,
+            min_size_mm: 0.3,
+            max_iterations: 5,
+            max_dofs: 400_000,
+            fixed_band_mm: 6.0,
+            singular_band_mm: 3.0,
             youngs_modulus_pa: 210e9,
             poisson_ratio: 0.3,
         }
+    }
+}
+
+impl FemConfig {
+    /// True when stage 3 refines adaptively.
+    pub fn adaptive(&self) -> bool {
+        self.target_error > 0.0
     }
 }
 
@@ -68,6 +107,8 @@ impl Default for FemConfig {
 pub struct CriterionConfig {
     pub yield_mpa: f64,
     pub safety_factor: f64,
+    /// Judge the peak plus its estimated error (the upper end of the error bar) instead of the peak.
+    pub with_error: bool,
 }
 
 impl Default for CriterionConfig {
@@ -75,6 +116,7 @@ impl Default for CriterionConfig {
         CriterionConfig {
             yield_mpa: 355.0,
             safety_factor: 1.5,
+            with_error: false,
         }
     }
 }
@@ -115,6 +157,10 @@ impl StudyConfig {
             ("driven.omega_rad_s", self.driven.omega_rad_s),
             ("driven.duration_s", self.driven.duration_s),
             ("fem.mesh_size_mm", self.fem.mesh_size_mm),
+            ("fem.initial_size_mm", self.fem.initial_size_mm),
+            ("fem.min_size_mm", self.fem.min_size_mm),
+            ("fem.fixed_band_mm", self.fem.fixed_band_mm),
+            ("fem.singular_band_mm", self.fem.singular_band_mm),
             ("fem.youngs_modulus_pa", self.fem.youngs_modulus_pa),
             ("criterion.yield_mpa", self.criterion.yield_mpa),
             ("criterion.safety_factor", self.criterion.safety_factor),
@@ -123,6 +169,13 @@ impl StudyConfig {
             if !(v.is_finite() && v > 0.0) {
                 bail!("`{key}` must be a positive number, got {v}");
             }
+        }
+        let t = self.fem.target_error;
+        if !(t.is_finite() && (0.0..1.0).contains(&t)) {
+            bail!("`fem.target_error` must lie in [0, 1) (0: one fixed mesh), got {t}");
+        }
+        if self.fem.max_iterations == 0 || self.fem.max_dofs < 1000 {
+            bail!("`fem.max_iterations` must be at least 1 and `fem.max_dofs` at least 1000");
         }
         if self.driven.steps == 0 {
             bail!("`driven.steps` must be at least 1");

@@ -21,7 +21,7 @@ use atomic_write::write_atomic;
 use cache::{Cache, design_key};
 use config::StudyConfig;
 use dynamics_stage::{DesignDynamics, dynamics_of_design, write_history_csv};
-use fem_stage::{DesignFem, fem_of_design};
+use fem_stage::{DesignFem, MeshMode, fem_of_design};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -199,7 +199,7 @@ fn study_one(
                 config,
                 &work,
                 &vtu,
-                None,
+                &MeshMode::from_config(config),
             )?)
         };
         Ok(DesignResult {

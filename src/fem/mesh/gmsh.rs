@@ -164,6 +164,19 @@ fn run(python: &Path, script: &Path, args: &[&std::ffi::OsStr]) -> Result<(Strin
     Ok((last.to_string(), secs))
 }
 
+/// What to ask of the mesher beyond the STL and the output folder.
+#[derive(Clone, Debug, Default)]
+pub struct MeshRequest<'a> {
+    /// Target (uniform) element size, mm; with a size field, the cap.
+    pub size_mm: f64,
+    /// A local size map ([`super::size_field`]), for adaptive refinement.
+    pub size_field: Option<&'a Path>,
+    /// Cache of the classified surface: written on first use, reused by later calls.
+    pub geometry: Option<&'a Path>,
+    /// Base name of the output files (default: the STL's stem).
+    pub name: Option<&'a str>,
+}
+
 /// Meshes `stl` (millimetres) with 10-node tetrahedra of target size `size_mm` by running
 /// `python script mesh STL OUT_DIR --size SIZE`, and reads the resulting `OUT_DIR/<stem>.rodmesh`.
 pub fn mesh_stl(
@@ -173,6 +186,27 @@ pub fn mesh_stl(
     size_mm: f64,
     out_dir: &Path,
 ) -> Result<MeshedRod> {
+    mesh_stl_with(
+        python,
+        script,
+        stl,
+        &MeshRequest {
+            size_mm,
+            ..MeshRequest::default()
+        },
+        out_dir,
+    )
+}
+
+/// [`mesh_stl`] with a size field, a classified-surface cache and an output name.
+pub fn mesh_stl_with(
+    python: &Path,
+    script: &Path,
+    stl: &Path,
+    request: &MeshRequest<'_>,
+    out_dir: &Path,
+) -> Result<MeshedRod> {
+    let size_mm = request.size_mm;
     if !(size_mm.is_finite() && size_mm > 0.0) {
         return Err(FemError::InvalidInput(format!(
             "mesh size must be > 0 mm, got {size_mm}"
@@ -180,17 +214,23 @@ pub fn mesh_stl(
     }
     std::fs::create_dir_all(out_dir).map_err(|e| FemError::io(out_dir, e))?;
     let size = format!("{size_mm}");
-    let (json, secs) = run(
-        python,
-        script,
-        &[
-            "mesh".as_ref(),
-            stl.as_os_str(),
-            out_dir.as_os_str(),
-            "--size".as_ref(),
-            size.as_ref(),
-        ],
-    )?;
+    let mut args: Vec<&std::ffi::OsStr> = vec![
+        "mesh".as_ref(),
+        stl.as_os_str(),
+        out_dir.as_os_str(),
+        "--size".as_ref(),
+        size.as_ref(),
+    ];
+    if let Some(f) = request.size_field {
+        args.extend(["--size-field".as_ref(), f.as_os_str()]);
+    }
+    if let Some(g) = request.geometry {
+        args.extend(["--geometry".as_ref(), g.as_os_str()]);
+    }
+    if let Some(n) = request.name {
+        args.extend(["--name".as_ref(), std::ffi::OsStr::new(n)]);
+    }
+    let (json, secs) = run(python, script, &args)?;
     let mut report: MeshReport = serde_json::from_str(&json)
         .map_err(|e| FemError::Mesher(format!("cannot parse the mesher's report ({e}): {json}")))?;
     report.seconds_wall = secs;

@@ -6,9 +6,10 @@
 
 pub mod gmsh;
 pub mod rodmesh;
+pub mod size_field;
 pub mod structured;
 
-pub use gmsh::{MeshReport, MeshedRod, convert_mesh, mesh_stl};
+pub use gmsh::{MeshReport, MeshRequest, MeshedRod, convert_mesh, mesh_stl, mesh_stl_with};
 pub use rodmesh::{read_rodmesh, write_rodmesh};
 
 use super::element::{ElementCoords, QuadratureChoice, check_jacobian, is_straight};

@@ -1,0 +1,135 @@
+//! A posteriori error estimates of a tetra10 stress solution, from the recovered stress σ*
+//! ([`super::recovery`]): the Zienkiewicz–Zhu estimator in the energy norm, a pointwise
+//! indicator for the von Mises stress, and an estimate of the error of the peak.
+//!
+//! * **Energy norm** (ZZ 1987, IJNME 24; ZZ 1992 Part 2): per element
+//!   η_e² = ∫_e (σ* − σ_h)ᵀ C⁻¹ (σ* − σ_h) dV, with C⁻¹ the isotropic compliance
+//!   (Δσᵀ C⁻¹ Δσ = [Σ Δσ_ii² − 2ν (Δσ_xx Δσ_yy + Δσ_yy Δσ_zz + Δσ_zz Δσ_xx)] / E
+//!   + (Δσ_xy² + Δσ_yz² + Δσ_zx²) / G), integrated with the 14-point degree-5 rule (exact for
+//!   a straight element: σ* is quadratic, σ_h linear). The relative error
+//!   η / (‖σ*‖² + η²)^½ is what CalculiX's ERR and Abaqus' energy-norm indicators report.
+//! * **Pointwise, for the von Mises stress**: von Mises is a seminorm of the stress tensor
+//!   (it is √(3/2) times the Frobenius norm of the deviator), so by the triangle inequality
+//!   |σ_vM(σ*) − σ_vM(σ_h)| ≤ σ_vM(σ* − σ_h). The element indicator is the largest
+//!   σ_vM(σ* − σ_h^e) over the element's ten nodes, with σ_h^e the element's own (unaveraged)
+//!   stress: a bound of how far the element's von Mises stress is from the recovered one, in Pa.
+//!   It drives the mesh sizes of the adaptive loop ([`super::adapt`]).
+//! * **The peak** (the quantity the criterion judges): P_h = max of the nodally averaged
+//!   von Mises stress over the nodes outside the band around the fixed bore; P* the same
+//!   maximum of σ_vM(σ*). The recovery estimate of its error is |P* − P_h| / P_h. Over an
+//!   adaptive sequence the peak's own convergence gives a second, goal-oriented estimate
+//!   (Richardson, in [`super::adapt`]).
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::element::{shape_gradients, strain};
+use super::error::Result;
+use super::material::{Material, von_mises};
+use super::mesh::TetMesh;
+use super::quadrature::TET14;
+use super::recovery::RecoveredStress;
+use super::stress::{Peak, StressField, peak_nodal};
+
+/// Δσᵀ C⁻¹ Δσ: twice the complementary energy density of a stress difference, Pa.
+pub fn energy_density2(material: &Material, d: &[f64; 6]) -> f64 {
+    let e = material.youngs_modulus_pa;
+    let nu = material.poisson_ratio;
+    let g = material.shear_modulus();
+    (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] - 2.0 * nu * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0]))
+        / e
+        + (d[3] * d[3] + d[4] * d[4] + d[5] * d[5]) / g
+}
+
+/// The estimates of one solution.
+#[derive(Clone, Debug)]
+pub struct ErrorEstimate {
+    /// Per element: max over its nodes of σ_vM(σ* − σ_h^e), Pa.
+    pub element_von_mises_error_pa: Vec<f64>,
+    /// Per element: η_e², J (N·m).
+    pub element_energy_error2: Vec<f64>,
+    /// Per element: max over its nodes of the recovered von Mises stress, Pa.
+    pub element_recovered_von_mises_pa: Vec<f64>,
+    /// Recovered von Mises stress per node, Pa.
+    pub recovered_von_mises_pa: Vec<f64>,
+    /// Figures.
+    pub summary: EstimateSummary,
+}
+
+/// The scalar figures of an [`ErrorEstimate`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct EstimateSummary {
+    /// ZZ energy-norm relative error η / (‖σ*‖² + η²)^½ over the whole rod.
+    pub energy_error_rel: f64,
+    /// P_h: max nodally averaged von Mises outside the fixed band, MPa.
+    pub peak_mpa: f64,
+    /// P*: max recovered von Mises outside the fixed band, MPa.
+    pub recovered_peak_mpa: f64,
+    /// |P* − P_h| / P_h: the recovery estimate of the peak's relative error.
+    pub peak_error_rel: f64,
+    /// σ_vM(σ* − σ_avg) at the node of P_h, relative to P_h (the pointwise bound there).
+    pub peak_node_bound_rel: f64,
+}
+
+/// Estimates the error of the solution `u` with stresses `field` and recovered stress `rec`;
+/// `mask` marks the nodes outside the band around the fixed bore (where the peak is taken).
+pub fn estimate_error(
+    mesh: &TetMesh,
+    material: &Material,
+    u: &[f64],
+    field: &StressField,
+    rec: &RecoveredStress,
+    mask: &[bool],
+) -> Result<ErrorEstimate> {
+    let per: Vec<(f64, f64, f64, f64)> = (0..mesh.n_elements())
+        .into_par_iter()
+        .map(|e| {
+            let el = &mesh.elements()[e];
+            let local = (0..10)
+                .map(|a| {
+                    let d: [f64; 6] =
+                        std::array::from_fn(|c| rec.nodal[el[a]][c] - field.element_nodal[e][a][c]);
+                    von_mises(&d)
+                })
+                .fold(0.0, f64::max);
+            let rec_vm = (0..10)
+                .map(|a| von_mises(&rec.nodal[el[a]]))
+                .fold(0.0, f64::max);
+            let x = mesh.element_coords(e);
+            let ue: [[f64; 3]; 10] =
+                std::array::from_fn(|a| std::array::from_fn(|j| u[3 * el[a] + j]));
+            let (mut err2, mut norm2) = (0.0, 0.0);
+            for (p, w) in TET14.points.iter().zip(TET14.weights) {
+                let (g, det) = shape_gradients(&x, *p, e, "quadrature point")?;
+                let sh = material.stress(&strain(&g, &ue));
+                let ss = rec.at(mesh, e, *p);
+                let d: [f64; 6] = std::array::from_fn(|c| ss[c] - sh[c]);
+                err2 += w * det * energy_density2(material, &d);
+                norm2 += w * det * energy_density2(material, &ss);
+            }
+            Ok((local, err2, norm2, rec_vm))
+        })
+        .collect::<Result<_>>()?;
+    let err2: f64 = per.iter().map(|p| p.1).sum();
+    let norm2: f64 = per.iter().map(|p| p.2).sum();
+    let recovered_vm: Vec<f64> = rec.nodal.iter().map(von_mises).collect();
+    let vm_avg = field.von_mises_averaged();
+    let ph: Peak = peak_nodal(mesh, &vm_avg, Some(mask));
+    let pr: Peak = peak_nodal(mesh, &recovered_vm, Some(mask));
+    let at_peak: [f64; 6] =
+        std::array::from_fn(|c| rec.nodal[ph.node][c] - field.averaged[ph.node][c]);
+    let summary = EstimateSummary {
+        energy_error_rel: (err2 / (norm2 + err2)).sqrt(),
+        peak_mpa: ph.value * 1e-6,
+        recovered_peak_mpa: pr.value * 1e-6,
+        peak_error_rel: (pr.value - ph.value).abs() / ph.value,
+        peak_node_bound_rel: von_mises(&at_peak) / ph.value,
+    };
+    Ok(ErrorEstimate {
+        element_von_mises_error_pa: per.iter().map(|p| p.0).collect(),
+        element_energy_error2: per.iter().map(|p| p.1).collect(),
+        element_recovered_von_mises_pa: per.iter().map(|p| p.3).collect(),
+        recovered_von_mises_pa: recovered_vm,
+        summary,
+    })
+}
