@@ -10,12 +10,13 @@ parameters (no calibration), so the exact B-rep is known and reproducible.
       The STL exactly as the designs are exported (gmsh surface mesh, 150 elements per turn of
       curvature, 0.8-6 mm, welded by float32 value, outward, validated): what rodstudy meshes.
 
-  fillet_rod.py reference OUT.msh --near H [--far 6] [--band 4]
+  fillet_rod.py reference OUT.msh --near H [--far 6] [--band 4] [--design N]
       A reference mesh made from the exact B-rep, independently of the STL route: curved 10-node
       tetrahedra (second-order nodes on the true fillets), element size H within BAND mm of the
       shank-to-eye fillets and the boss fillets, growing to FAR elsewhere. A sequence of H
       (e.g. 1.4, 1.0, 0.7, 0.5) solved with `rodstudy fem OUT.stl --mesh OUT.msh` and extrapolated
       (Richardson) gives the converged peak that the adaptive result on the STL is judged against.
+      --design N does the same for design N of make_designs.py (calibrated again, as generated).
 
 Both print one JSON line (paths, counts, timings).
 """
@@ -47,11 +48,16 @@ def designs_module():
 PARAMS = {"boss_half_span": 55.0, "eye_b_r": 27.0, "shank_h": 15.0, "shank_dh": 4.0, "fillet_r": 8.0}
 
 
-def build(md):
-    d = md.Design(0, "fillet test rod", "solid", dict(PARAMS), (), ())
-    p = d.params()
-    md.check_sensible(d, p)
+def build(md, design: int | None = None):
+    """The fillet test rod, or design N of make_designs.py (calibrated again, as it generates it)."""
     md.gmsh_start()
+    if design is not None:
+        res = md.generate(md.DESIGNS[design])
+        d, p = res["design"], res["params"]
+    else:
+        d = md.Design(0, "fillet test rod", "solid", dict(PARAMS), (), ())
+        p = d.params()
+    md.check_sensible(d, p)
     return d, p, md.build_rod(d, p)
 
 
@@ -91,7 +97,7 @@ def cmd_reference(args) -> dict:
 
     md = designs_module()
     t0 = time.perf_counter()
-    d, p, vol = build(md)
+    d, p, vol = build(md, args.design)
     fillets = fillet_surfaces(md, vol, p)
     gmsh.model.mesh.clear()
     for k, v in {"Mesh.MeshSizeFromCurvature": 0, "Mesh.MeshSizeMin": 0.0, "Mesh.MeshSizeMax": args.far,
@@ -134,6 +140,7 @@ def main(argv=None) -> int:
     pr.add_argument("--near", type=float, required=True)
     pr.add_argument("--far", type=float, default=6.0)
     pr.add_argument("--band", type=float, default=4.0)
+    pr.add_argument("--design", type=int, help="design N of make_designs.py instead of the fillet test rod")
     args = ap.parse_args(argv)
     info = {"stl": cmd_stl, "reference": cmd_reference}[args.cmd](args)
     print(json.dumps(info, sort_keys=True))

@@ -4,12 +4,11 @@
 use crate::fem::study::refinement_study_stl;
 use crate::fem::{BoreSpec, Material, RodOptions};
 use crate::geometry::design::mass_of_design;
-use crate::geometry::sidecar::DesignSettings;
 use crate::mechanism::Method;
 use crate::python_env::{pipeline_script, python};
 use crate::study::config::StudyConfig;
 use crate::study::dynamics_stage::dynamics_of_design;
-use crate::study::fem_stage::{DesignFem, MESHER, MeshMode, fem_of_design};
+use crate::study::fem_stage::{DesignFem, MESHER, MeshMode, fem_of_design, rod_frame_surface};
 use anyhow::{Result, bail};
 use clap::Args;
 use std::path::PathBuf;
@@ -45,6 +44,13 @@ pub struct FemArgs {
     /// Refinement study over these element sizes [mm] instead of one analysis, e.g. 8,5,3.5.
     #[arg(long, value_delimiter = ',')]
     refine: Option<Vec<f64>>,
+    /// Speed against error: uniform meshes of `--sizes` and the adaptive sequence, each in its
+    /// own process; writes convergence.md/.csv/.json/.svg into `--out`.
+    #[arg(long, conflicts_with_all = ["refine", "mesh", "size"])]
+    convergence: bool,
+    /// Uniform sizes of `--convergence` [mm].
+    #[arg(long, value_delimiter = ',', default_value = "8,5,3.5,2.5")]
+    sizes: Vec<f64>,
 }
 
 pub fn run(args: FemArgs) -> Result<i32> {
@@ -86,6 +92,30 @@ pub fn run(args: FemArgs) -> Result<i32> {
     };
     if let Some(sizes) = &args.refine {
         return refine(&args, &config, force, sizes);
+    }
+    if args.convergence {
+        let c = crate::bench::fem_convergence::convergence(
+            &args.design,
+            &args.sizes,
+            if config.fem.adaptive() {
+                config.fem.target_error
+            } else {
+                0.03
+            },
+            force,
+            args.config.as_deref(),
+            &args.out,
+        )?;
+        if args.json {
+            println!("{}", serde_json::to_string_pretty(&c)?);
+        } else {
+            print!("{}", crate::bench::fem_convergence::markdown(&c));
+            eprintln!(
+                "wrote {}/convergence.{{md,csv,json,svg}}",
+                args.out.display()
+            );
+        }
+        return Ok(0);
     }
     let result = fem_of_design(
         &args.design,
@@ -216,13 +246,12 @@ fn print_result(d: &DesignFem) {
 }
 
 fn refine(args: &FemArgs, config: &StudyConfig, force: f64, sizes: &[f64]) -> Result<i32> {
-    let settings = DesignSettings::for_stl(&args.design)?;
-    let mm = |v: nalgebra::Vector3<f64>| [v.x * 1e3, v.y * 1e3, v.z * 1e3];
-    let a = settings.pin_axis;
+    // meshed in the rod frame, mm, as stage 3 meshes (any units and pose)
+    let surface = rod_frame_surface(&args.design, &args.out.join("refinement"))?;
     let bores = BoreSpec::from_mm(
-        mm(settings.crank_pin_m),
-        mm(settings.piston_pin_m),
-        [a.x, a.y, a.z],
+        [0.0, 0.0, 0.0],
+        [surface.centre_distance_mm, 0.0, 0.0],
+        [0.0, 0.0, 1.0],
     );
     let material = Material {
         youngs_modulus_pa: config.fem.youngs_modulus_pa,
@@ -231,13 +260,16 @@ fn refine(args: &FemArgs, config: &StudyConfig, force: f64, sizes: &[f64]) -> Re
     let study = refinement_study_stl(
         &python()?,
         &pipeline_script(MESHER),
-        &args.design,
+        &surface.stl,
         sizes,
         &args.out.join("refinement"),
         &material,
         &bores,
         force,
-        &RodOptions::default(),
+        &RodOptions {
+            fixed_band_m: Some(config.fem.fixed_band_mm * 1e-3),
+            ..RodOptions::default()
+        },
     )?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&study)?);

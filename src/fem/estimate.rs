@@ -16,9 +16,15 @@
 //!   It drives the mesh sizes of the adaptive loop ([`super::adapt`]).
 //! * **The peak** (the quantity the criterion judges): P_h = max of the nodally averaged
 //!   von Mises stress over the nodes outside the band around the fixed bore; P* the same
-//!   maximum of σ_vM(σ*). The recovery estimate of its error is |P* − P_h| / P_h. Over an
-//!   adaptive sequence the peak's own convergence gives a second, goal-oriented estimate
-//!   (Richardson, in [`super::adapt`]).
+//!   maximum of σ_vM(σ*). The recovery estimate of its error is |P* − P_h| / P_h. It is blind to
+//!   what the patches cannot see, above all a fillet that the straight-sided elements facet
+//!   coarsely (design 1 at 6 mm: P* agrees with P_h to 0.1 % while both are 14 % below the
+//!   converged peak). On a single mesh the reported estimate is therefore the **local bound**:
+//!   the largest pointwise indicator among the elements within two element sizes of the peak,
+//!   relative to P_h (max with the recovery estimate). It is conservative (measured on design 1
+//!   at 8, 6, 5, 3.5 mm: 1.2–8.5 × the true error for F_y) but it does not miss: a 5 mm figure
+//!   carries a ± 26 % bar, not ± 1 %. Over an adaptive sequence the peak's own convergence gives
+//!   the efficient, goal-oriented estimate (Richardson, in [`super::adapt`]).
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -69,6 +75,17 @@ pub struct EstimateSummary {
     pub peak_error_rel: f64,
     /// σ_vM(σ* − σ_avg) at the node of P_h, relative to P_h (the pointwise bound there).
     pub peak_node_bound_rel: f64,
+    /// The largest element indicator within two element sizes of the peak, relative to P_h.
+    #[serde(default)]
+    pub peak_local_bound_rel: f64,
+}
+
+impl EstimateSummary {
+    /// The estimate of the peak's relative error on a single mesh: the local bound, or the
+    /// recovery estimate if that is larger.
+    pub fn single_mesh_estimate(&self) -> f64 {
+        self.peak_local_bound_rel.max(self.peak_error_rel)
+    }
 }
 
 /// Estimates the error of the solution `u` with stresses `field` and recovered stress `rec`;
@@ -118,12 +135,39 @@ pub fn estimate_error(
     let pr: Peak = peak_nodal(mesh, &recovered_vm, Some(mask));
     let at_peak: [f64; 6] =
         std::array::from_fn(|c| rec.nodal[ph.node][c] - field.averaged[ph.node][c]);
+    // the local bound: elements within two element sizes of the peak node
+    let size = |e: usize| {
+        let el = &mesh.elements()[e];
+        super::shape::TET10_EDGES
+            .iter()
+            .map(|[a, b]| super::mesh::dist(mesh.nodes()[el[*a]], mesh.nodes()[el[*b]]))
+            .sum::<f64>()
+            / 6.0
+    };
+    let around: Vec<usize> = (0..mesh.n_elements())
+        .filter(|&e| mesh.elements()[e].contains(&ph.node))
+        .collect();
+    let h_peak = around.iter().map(|&e| size(e)).sum::<f64>() / around.len().max(1) as f64;
+    let local_bound = (0..mesh.n_elements())
+        .into_par_iter()
+        .filter(|&e| {
+            let el = &mesh.elements()[e];
+            el.iter().any(|&n| mask[n]) && {
+                let c: [f64; 3] = std::array::from_fn(|j| {
+                    el[..4].iter().map(|&n| mesh.nodes()[n][j]).sum::<f64>() / 4.0
+                });
+                super::mesh::dist(c, ph.location_m) <= 2.0 * h_peak
+            }
+        })
+        .map(|e| per[e].0)
+        .reduce(|| 0.0, f64::max);
     let summary = EstimateSummary {
         energy_error_rel: (err2 / (norm2 + err2)).sqrt(),
         peak_mpa: ph.value * 1e-6,
         recovered_peak_mpa: pr.value * 1e-6,
         peak_error_rel: (pr.value - ph.value).abs() / ph.value,
         peak_node_bound_rel: von_mises(&at_peak) / ph.value,
+        peak_local_bound_rel: local_bound / ph.value,
     };
     Ok(ErrorEstimate {
         element_von_mises_error_pa: per.iter().map(|p| p.0).collect(),

@@ -128,6 +128,10 @@ pub struct AdaptiveStep {
     /// The convergence order the estimate used (Richardson), 0 where it used recovery alone.
     #[serde(default)]
     pub order: f64,
+    /// The peak extrapolated with that order (Richardson), MPa; the peak itself where there is
+    /// no extrapolation.
+    #[serde(default)]
+    pub extrapolated_mpa: f64,
     /// Wall time of this iteration (mesh, solve, estimate), s.
     pub seconds: f64,
 }
@@ -360,7 +364,7 @@ pub fn solve_rod_fields(
             reaction_n: reaction,
             reaction_balance_rel: bal,
             solve_residual_rel: sol.residual_rel[c],
-            estimated_error_rel: estimate.summary.peak_error_rel,
+            estimated_error_rel: estimate.summary.single_mesh_estimate(),
             error_estimate: estimate.summary,
             adaptive: Vec::new(),
             vtu: None,

@@ -19,6 +19,7 @@ pub mod mass_properties;
 pub mod mechanism_frame;
 pub mod primitives;
 pub mod sidecar;
+pub mod simplify;
 pub mod stl_file;
 pub mod validate;
 pub mod weld;

@@ -12,7 +12,8 @@
 //! target_error = 0.03          # adaptive refinement to this estimated error of the peak; 0: one
 //!                              # fixed mesh of mesh_size_mm
 //! mesh_size_mm = 5.0           # the fixed mesh's size (the thesis' 5 mm)
-//! initial_size_mm = 8.0        # adaptive: first mesh (uniform) and largest size
+//! initial_size_mm = 5.0        # adaptive: first mesh (uniform)
+//! max_size_mm = 10.0           # adaptive: largest size, where the stress is low
 //! min_size_mm = 0.3            # adaptive: smallest size (the STL's facet spacing floors it too)
 //! max_iterations = 5           # adaptive: most meshes
 //! max_dofs = 400000            # adaptive: largest mesh
@@ -61,8 +62,10 @@ pub struct FemConfig {
     pub target_error: f64,
     /// Element size of the fixed mesh, mm.
     pub mesh_size_mm: f64,
-    /// Adaptive: uniform size of the first mesh and the largest size, mm.
+    /// Adaptive: uniform size of the first mesh, mm.
     pub initial_size_mm: f64,
+    /// Adaptive: largest size (where the stress is low), mm.
+    pub max_size_mm: f64,
     /// Adaptive: smallest size, mm.
     pub min_size_mm: f64,
     /// Adaptive: most meshes in the sequence.
@@ -82,7 +85,8 @@ impl Default for FemConfig {
         FemConfig {
             target_error: 0.03,
             mesh_size_mm: 5.0,
-            initial_size_mm: 8.0,
+            initial_size_mm: 5.0,
+            max_size_mm: 10.0,
             min_size_mm: 0.3,
             max_iterations: 5,
             max_dofs: 400_000,
@@ -158,6 +162,7 @@ impl StudyConfig {
             ("driven.duration_s", self.driven.duration_s),
             ("fem.mesh_size_mm", self.fem.mesh_size_mm),
             ("fem.initial_size_mm", self.fem.initial_size_mm),
+            ("fem.max_size_mm", self.fem.max_size_mm),
             ("fem.min_size_mm", self.fem.min_size_mm),
             ("fem.fixed_band_mm", self.fem.fixed_band_mm),
             ("fem.singular_band_mm", self.fem.singular_band_mm),

@@ -23,6 +23,8 @@ use crate::fem::mesh::size_field::write_size_field;
 use crate::fem::{BoreSpec, FemResult, Material, RodOptions, TetMesh};
 use crate::geometry::design::load_design;
 use crate::geometry::primitives::{binary_stl, to_soup};
+use crate::geometry::simplify::simplify;
+use crate::geometry::validate::validate;
 use crate::python_env::{pipeline_script, python};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
@@ -55,6 +57,9 @@ pub struct MeshSummary {
     /// The adaptive sequence, when the mesh was refined adaptively.
     #[serde(default)]
     pub adaptive: Option<AdaptiveSummary>,
+    /// Triangles of the STL export and of the surface given to gmsh after simplification.
+    #[serde(default)]
+    pub surface_triangles: [usize; 2],
 }
 
 /// How an adaptive sequence went.
@@ -148,7 +153,15 @@ pub struct RodFrameSurface {
     pub frame: crate::geometry::mechanism_frame::MechanismFrame,
     /// File units → metres.
     pub to_metres: f64,
+    /// Triangles of the export (the STL written has `triangles.len()`).
+    pub triangles_export: usize,
+    /// Largest distance of a kept vertex from the facets it absorbed, mm.
+    pub simplify_max_error_mm: f64,
 }
+
+/// Tolerance of the simplification of the export before meshing, mm (5 µm: far below any element
+/// size, above the float32 noise of a millimetre export).
+pub const SIMPLIFY_TOLERANCE_MM: f64 = 0.005;
 
 /// Writes `work_dir/rod_frame.stl`: the validated surface of `stl` in the rod frame, mm.
 pub fn rod_frame_surface(stl: &Path, work_dir: &Path) -> Result<RodFrameSurface> {
@@ -160,6 +173,14 @@ pub fn rod_frame_surface(stl: &Path, work_dir: &Path) -> Result<RodFrameSurface>
         let p = *v - f.origin;
         *v = nalgebra::Vector3::new(p.dot(&f.x), p.dot(&f.y), p.dot(&f.z)) * 1e3;
     }
+    // what gmsh reads must not grow with the export's triangle count: flat facets cut into many
+    // triangles merge back (zero error), curved ones stay within SIMPLIFY_TOLERANCE_MM
+    let before = mesh.triangles.len();
+    let (simplified, report) = simplify(&mesh, SIMPLIFY_TOLERANCE_MM);
+    let mesh = match validate(simplified) {
+        Ok(v) if v.warnings.is_empty() => v.mesh,
+        _ => mesh,
+    };
     let bytes = binary_stl(&to_soup(&mesh));
     std::fs::create_dir_all(work_dir)
         .with_context(|| format!("{}: cannot create", work_dir.display()))?;
@@ -176,6 +197,8 @@ pub fn rod_frame_surface(stl: &Path, work_dir: &Path) -> Result<RodFrameSurface>
             .collect(),
         frame: *f,
         to_metres: d.settings.units.to_metres(),
+        triangles_export: before,
+        simplify_max_error_mm: report.max_error,
     })
 }
 
@@ -258,6 +281,7 @@ pub fn fem_of_design(
                 seconds: start.elapsed().as_secs_f64(),
                 frame,
                 adaptive: None,
+                surface_triangles: [surface.triangles_export, surface.triangles.len()],
             };
             (fem, summary)
         }
@@ -277,6 +301,7 @@ pub fn fem_of_design(
                 seconds: r.seconds_wall.max(r.seconds_total),
                 frame,
                 adaptive: None,
+                surface_triangles: [surface.triangles_export, surface.triangles.len()],
             };
             (fem, summary)
         }
@@ -292,6 +317,7 @@ pub fn fem_of_design(
             let opts = AdaptOptions {
                 target_error_rel: c.target_error,
                 initial_size_m: c.initial_size_mm * 1e-3,
+                max_size_m: c.max_size_mm * 1e-3,
                 min_size_m: c.min_size_mm * 1e-3,
                 max_iterations: c.max_iterations,
                 max_dofs: c.max_dofs,
@@ -302,15 +328,36 @@ pub fn fem_of_design(
                 let dir = work_dir.join(format!("adapt{}", ask.iteration));
                 std::fs::create_dir_all(&dir)
                     .map_err(|e| crate::fem::FemError::Mesher(format!("{}: {e}", dir.display())))?;
-                let field = dir.join("size_field.bin");
-                let field = match ask.size_map {
-                    Some((m, s)) => {
-                        write_size_field(&field, m, s, 1e3)?;
-                        Some(field.as_path())
+                let field_path = dir.join("size_field.bin");
+                // gmsh can fail to remesh a faceted surface coarsely where thin features meet
+                // ("overlapping facets"): a failed mesh is asked again with all sizes × 0.8
+                let mut scale = 1.0;
+                let mut tries = 0;
+                let meshed = loop {
+                    let field = match ask.size_map {
+                        Some((m, s)) => {
+                            let scaled: Vec<f64> = s.iter().map(|v| v * scale).collect();
+                            write_size_field(&field_path, m, &scaled, 1e3)?;
+                            Some(field_path.as_path())
+                        }
+                        None => None,
+                    };
+                    match request(ask.size_m * 1e3 * scale, field, "rod", &dir) {
+                        Ok(m) => break m,
+                        Err(e) if tries < 2 => {
+                            eprintln!(
+                                "{}: mesh {} failed, sizes × {:.2} next: {}",
+                                stl.display(),
+                                ask.iteration,
+                                0.8 * scale,
+                                e.to_string().lines().last().unwrap_or_default()
+                            );
+                            scale *= 0.8;
+                            tries += 1;
+                        }
+                        Err(e) => return Err(e),
                     }
-                    None => None,
                 };
-                let meshed = request(ask.size_m * 1e3, field, "rod", &dir)?;
                 let secs = meshed.report.seconds_wall.max(meshed.report.seconds_total);
                 last_report = Some(meshed.report);
                 Ok((meshed.mesh, secs))
@@ -340,6 +387,7 @@ pub fn fem_of_design(
                     facet_spacing_median_mm: facets.median_spacing(),
                     monotone: out.monotone,
                 }),
+                surface_triangles: [surface.triangles_export, surface.triangles.len()],
             };
             (out.solution.result, summary)
         }

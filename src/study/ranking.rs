@@ -32,9 +32,11 @@ struct Row<'a> {
     i_xx_kgm2: f64,
     peak_pin_force_n: f64,
     fx_von_mises_away_from_fixed_mpa: Option<f64>,
+    fx_estimated_error_rel: Option<f64>,
     fx_von_mises_averaged_mpa: Option<f64>,
     fx_von_mises_unaveraged_mpa: Option<f64>,
     fy_von_mises_away_from_fixed_mpa: Option<f64>,
+    fy_estimated_error_rel: Option<f64>,
     fy_von_mises_averaged_mpa: Option<f64>,
     fy_von_mises_unaveraged_mpa: Option<f64>,
     max_displacement_mm: Option<f64>,
@@ -61,9 +63,11 @@ fn rows(results: &StudyResults) -> Vec<Row<'_>> {
                 i_xx_kgm2: d.mass.i_xx_kgm2,
                 peak_pin_force_n: d.dynamics.peak_pin_force_n,
                 fx_von_mises_away_from_fixed_mpa: fx.map(|c| c.max_von_mises_away_from_fixed_mpa),
+                fx_estimated_error_rel: fx.map(|c| c.estimated_error_rel),
                 fx_von_mises_averaged_mpa: fx.map(|c| c.max_von_mises_averaged_mpa),
                 fx_von_mises_unaveraged_mpa: fx.map(|c| c.max_von_mises_unaveraged_mpa),
                 fy_von_mises_away_from_fixed_mpa: fy.map(|c| c.max_von_mises_away_from_fixed_mpa),
+                fy_estimated_error_rel: fy.map(|c| c.estimated_error_rel),
                 fy_von_mises_averaged_mpa: fy.map(|c| c.max_von_mises_averaged_mpa),
                 fy_von_mises_unaveraged_mpa: fy.map(|c| c.max_von_mises_unaveraged_mpa),
                 max_displacement_mm: f.map(|f| {
@@ -97,13 +101,21 @@ pub fn csv(results: &StudyResults) -> Result<Vec<u8>> {
 pub fn markdown(results: &StudyResults) -> String {
     let c = &results.config.criterion;
     let mut out = format!(
-        "# Ranking of the designs\n\nDesigns that meet the stress criterion first (max von Mises away from the fixed bore ≤ yield {} MPa / safety factor {} = {:.1} MPa, in both the F_x and F_y cases), then by the peak crank–rod pin force of the driven crank–slider, lowest first. Stresses [MPa] per case: away from the fixed bore (the convergent measure, judged) / nodally averaged / raw element-nodal peak at 5 mm (a singularity at the fixed edge, shown for reference).\n\n| rank | design | mass [kg] | l1 [mm] | I_zz [kg·m²] | I_xx [kg·m²] | peak pin force [N] | σ F_x [MPa] | σ F_y [MPa] | max displ. [mm] | safety factor | status |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "# Ranking of the designs\n\nDesigns that meet the stress criterion first (max von Mises away from the fixed bore ≤ yield {} MPa / safety factor {} = {:.1} MPa, in both the F_x and F_y cases{}), then by the peak crank–rod pin force of the driven crank–slider, lowest first. Stresses [MPa] per case: away from the fixed bore and from sharp re-entrant edges (the convergent measure, judged) ± its estimated error / nodally averaged / raw element-nodal peak (at the fixed edge, a singularity, shown for reference).\n\n| rank | design | mass [kg] | l1 [mm] | I_zz [kg·m²] | I_xx [kg·m²] | peak pin force [N] | σ F_x [MPa] | σ F_y [MPa] | max displ. [mm] | safety factor | status |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
         c.yield_mpa,
         c.safety_factor,
-        c.yield_mpa / c.safety_factor
+        c.yield_mpa / c.safety_factor,
+        if c.with_error {
+            ", the peak plus its estimated error"
+        } else {
+            ""
+        }
     );
-    let triple = |a: Option<f64>, b: Option<f64>, c: Option<f64>| match (a, b, c) {
-        (Some(a), Some(b), Some(c)) => format!("{a:.1} / {b:.1} / {c:.1}"),
+    let triple = |a: Option<f64>, e: Option<f64>, b: Option<f64>, c: Option<f64>| match (a, e, b, c)
+    {
+        (Some(a), Some(e), Some(b), Some(c)) => {
+            format!("{a:.1} ± {:.1} % / {b:.1} / {c:.1}", 100.0 * e)
+        }
         _ => "—".into(),
     };
     for r in rows(results) {
@@ -118,11 +130,13 @@ pub fn markdown(results: &StudyResults) -> String {
             r.peak_pin_force_n,
             triple(
                 r.fx_von_mises_away_from_fixed_mpa,
+                r.fx_estimated_error_rel,
                 r.fx_von_mises_averaged_mpa,
                 r.fx_von_mises_unaveraged_mpa
             ),
             triple(
                 r.fy_von_mises_away_from_fixed_mpa,
+                r.fy_estimated_error_rel,
                 r.fy_von_mises_averaged_mpa,
                 r.fy_von_mises_unaveraged_mpa
             ),

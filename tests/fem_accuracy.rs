@@ -1,0 +1,214 @@
+//! Stage 3 accuracy end to end (issue 10): the stress does not depend on the units or the pose of
+//! the export, and the adaptive loop reaches a converged reference within its target.
+//!
+//! References: the same rod in millimetres as the one to compare with (units, pose); for the
+//! adaptive loop, the fillet test rod of `pipeline/fillet_rod.py` whose converged peaks were
+//! established independently of the STL route (`tests/data/fillet_rod_reference.json`: curved
+//! tetra10 meshes of the exact OpenCASCADE geometry, refined at the fillets, extrapolated).
+
+use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
+use rodstudy::geometry::primitives::{binary_stl, to_soup, transformed};
+use rodstudy::geometry::stl_file::read_stl_file;
+use rodstudy::geometry::weld::weld;
+use rodstudy::study::config::StudyConfig;
+use rodstudy::study::fem_stage::{DesignFem, MeshMode, fem_of_design};
+use std::path::Path;
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Writes `dir/NAME.stl` (design 1 scaled by `scale` from mm, then rotated and moved) with its
+/// sidecar in `units`.
+fn variant(
+    dir: &Path,
+    name: &str,
+    units: &str,
+    scale: f64,
+    rot: Matrix3<f64>,
+    shift: Vector3<f64>,
+) {
+    let (soup, _) = read_stl_file(&root().join("designs/design1.stl")).unwrap();
+    let mesh = weld(&soup).scaled(scale);
+    let moved = transformed(&mesh, &rot, shift);
+    std::fs::write(
+        dir.join(format!("{name}.stl")),
+        binary_stl(&to_soup(&moved)),
+    )
+    .unwrap();
+    let a = shift;
+    let b = rot * Vector3::new(180.0 * scale, 0.0, 0.0) + shift;
+    let z = rot * Vector3::z();
+    std::fs::write(
+        dir.join(format!("{name}.toml")),
+        format!(
+            "units = \"{units}\"\ncrank_pin = [{}, {}, {}]\npiston_pin = [{}, {}, {}]\npin_axis = [{}, {}, {}]\n",
+            a.x, a.y, a.z, b.x, b.y, b.z, z.x, z.y, z.z
+        ),
+    )
+    .unwrap();
+}
+
+fn fem(dir: &Path, name: &str, config: &StudyConfig, mode: &MeshMode) -> DesignFem {
+    let work = dir.join(format!("work-{name}"));
+    fem_of_design(
+        &dir.join(format!("{name}.stl")),
+        7500.0,
+        config,
+        &work,
+        &work.join("vtu"),
+        mode,
+    )
+    .unwrap_or_else(|e| panic!("{name}: {e:#}"))
+}
+
+#[test]
+fn the_stress_does_not_depend_on_units_or_pose() {
+    let dir = tempfile::tempdir().unwrap();
+    let id = Matrix3::identity();
+    let turn = *Rotation3::from_axis_angle(&Unit::new_normalize(Vector3::new(1.0, 2.0, 3.0)), 0.7)
+        .matrix();
+    variant(dir.path(), "mm", "mm", 1.0, id, Vector3::zeros());
+    variant(dir.path(), "m", "m", 1e-3, id, Vector3::zeros());
+    variant(dir.path(), "in", "in", 1.0 / 25.4, id, Vector3::zeros());
+    // metres, turned about a skew axis and moved 1.24 m away
+    variant(
+        dir.path(),
+        "m_moved",
+        "m",
+        1e-3,
+        turn,
+        Vector3::new(1.2, -0.3, 0.05),
+    );
+    // millimetres, turned and moved 2 m away
+    variant(
+        dir.path(),
+        "mm_moved",
+        "mm",
+        1.0,
+        turn,
+        Vector3::new(-2000.0, 150.0, 700.0),
+    );
+    let config = StudyConfig::default();
+    let mode = MeshMode::Fixed(6.0);
+    let base = fem(dir.path(), "mm", &config, &mode);
+    for name in ["m", "in", "m_moved", "mm_moved"] {
+        let v = fem(dir.path(), name, &config, &mode);
+        for (a, b, case) in [
+            (&base.fem.fx, &v.fem.fx, "fx"),
+            (&base.fem.fy, &v.fem.fy, "fy"),
+        ] {
+            let (sa, sb) = (
+                a.max_von_mises_away_from_fixed_mpa,
+                b.max_von_mises_away_from_fixed_mpa,
+            );
+            let bar = a.estimated_error_rel + b.estimated_error_rel;
+            let diff = (sa - sb).abs() / sa;
+            eprintln!(
+                "{name} {case}: {sb:.3} vs {sa:.3} MPa ({diff:.1e}; error bars {bar:.3}); displacement {:.5} vs {:.5} mm",
+                b.max_displacement_mm, a.max_displacement_mm
+            );
+            assert!(
+                diff <= bar,
+                "{name} {case}: {sb} vs {sa} MPa beyond the error bars {bar}"
+            );
+            let du = (a.max_displacement_mm - b.max_displacement_mm).abs() / a.max_displacement_mm;
+            assert!(du <= bar, "{name} {case}: displacement {du}");
+            // The largest displacement is a smooth, global quantity: the meshes of the five
+            // variants differ only through the float32 rounding of the exports (gmsh's mesh is
+            // not stable under it, so a coarse mesh's peak stress moves within its error bar),
+            // and it agrees far more closely (measured: 1e-4).
+            assert!(du < 5e-3, "{name} {case}: displacement differs by {du}");
+        }
+    }
+}
+
+/// Richardson extrapolation of the last two of a sequence of peaks with element sizes `h` and
+/// order `q`; with the order observed from the last three where they change monotonically.
+fn extrapolate(h: &[f64], p: &[f64]) -> (f64, f64) {
+    let n = p.len();
+    let (d1, d2) = (p[n - 2] - p[n - 3], p[n - 1] - p[n - 2]);
+    let r = h[n - 2] / h[n - 1];
+    if d1 * d2 > 0.0 {
+        let q = (d1 / d2).ln() / r.ln();
+        let c = d2 / (r.powf(q) - 1.0);
+        (p[n - 1] + c, c.abs().max(1e-9))
+    } else {
+        // not monotone: the mean of the last two, half their difference as the uncertainty
+        (0.5 * (p[n - 1] + p[n - 2]), 0.5 * d2.abs())
+    }
+}
+
+#[test]
+fn adaptive_peak_reaches_the_converged_reference_of_the_fillet_rod() {
+    let data: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(root().join("tests/data/fillet_rod_reference.json")).unwrap(),
+    )
+    .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let stl = dir.path().join("fillet_rod.stl");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_rodstudy"))
+        .args(["pipeline", "fillet_rod.py", "stl"])
+        .arg(&stl)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let config = StudyConfig::default();
+    assert_eq!(config.fem.target_error, 0.03);
+    let force = data["force_n"].as_f64().unwrap();
+    let work = dir.path().join("work");
+    let r = fem_of_design(
+        &stl,
+        force,
+        &config,
+        &work,
+        &work.join("vtu"),
+        &MeshMode::Adaptive,
+    )
+    .unwrap();
+    let h: Vec<f64> = data["near_size_mm"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    // the target holds for the governing case (F_y here); the smaller case's error need only be
+    // as small in MPa (3 % of the governing peak)
+    let governing = r
+        .fem
+        .fx
+        .max_von_mises_away_from_fixed_mpa
+        .max(r.fem.fy.max_von_mises_away_from_fixed_mpa);
+    for (case, got) in [("fx", &r.fem.fx), ("fy", &r.fem.fy)] {
+        let p: Vec<f64> = data[case]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        let (reference, uncertainty) = extrapolate(&h, &p);
+        let peak = got.max_von_mises_away_from_fixed_mpa;
+        let target = 0.03 * (governing / peak).max(1.0);
+        let true_error = (peak - reference).abs() / reference;
+        let est = got.estimated_error_rel;
+        eprintln!(
+            "{case}: adaptive {peak:.2} MPa ± {:.2} % (target {:.1} %), reference {reference:.2} ± {:.2} MPa: true error {:.2} %, true / estimated {:.2}",
+            100.0 * est,
+            100.0 * target,
+            uncertainty,
+            100.0 * true_error,
+            true_error / est
+        );
+        assert!(est <= target, "{case}: converged to the target");
+        assert!(
+            true_error <= target,
+            "{case}: within the target of the reference"
+        );
+        // the error bar is honest: the true error is within twice the estimate (with the
+        // reference's own uncertainty)
+        assert!(
+            true_error <= 2.0 * est + uncertainty / reference,
+            "{case}: true {true_error} vs estimated {est}"
+        );
+    }
+}
