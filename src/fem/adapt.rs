@@ -158,11 +158,11 @@ struct PeakHistory {
 }
 
 /// The goal-oriented estimate of the last peak of `h` (see the module documentation): the
-/// single-mesh `bound` on the first mesh, Richardson afterwards, with the recovery estimate `zz`
-/// of the last mesh as the floor of the fallback for a sequence that does not converge
-/// monotonically; returns (estimate, monotone so far,
-/// order used (0: none), extrapolated peak).
-fn peak_estimate(h: &PeakHistory, bound: f64, zz: f64, order: f64) -> (f64, bool, f64, f64) {
+/// single-mesh `bound` on the first mesh, Richardson afterwards; where the peak was not refined
+/// or the sequence does not converge monotonically, the spread of the last three peaks (with two,
+/// the last change or the previous estimate, whichever is larger); returns (estimate, monotone so far, order used
+/// (0: none), extrapolated peak).
+fn peak_estimate(h: &PeakHistory, bound: f64, order: f64) -> (f64, bool, f64, f64) {
     let v = &h.values;
     let k = v.len() - 1;
     if k == 0 {
@@ -189,9 +189,21 @@ fn peak_estimate(h: &PeakHistory, bound: f64, zz: f64, order: f64) -> (f64, bool
         }
     }
     if !monotone || r < 1.15 {
-        // not refined at the peak (or no convergence): nothing new is known about its error
-        let previous = h.estimates.last().copied().unwrap_or(0.0);
-        return ((d2.abs() / p2).max(zz).max(previous), monotone, 0.0, p2);
+        // not refined at the peak, or not converging monotonically: no power law to extrapolate.
+        // With three values the uncertainty is their spread (what refinement has been seen to
+        // change); with two, the last change or the previous estimate, whichever is larger.
+        let e = if k >= 2 {
+            let last3 = [v[k - 2].0, p1, p2];
+            let (lo, hi) = last3
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+                    (a.min(x), b.max(x))
+                });
+            (hi - lo) / p2
+        } else {
+            (d2.abs() / p2).max(h.estimates.last().copied().unwrap_or(0.0))
+        };
+        return (e, monotone, 0.0, p2);
     }
     // Richardson's correction, but never less than the last change itself: the peak of a
     // straight-sided mesh on a faceted fillet moves by ~1 % between meshes for reasons no power
@@ -272,7 +284,6 @@ pub fn adaptive_rod(
             let (e, mono, q, extrapolated) = peak_estimate(
                 &histories[c],
                 est.summary.single_mesh_estimate(),
-                est.summary.peak_error_rel,
                 opts.order,
             );
             histories[c].monotone = mono;
@@ -485,7 +496,7 @@ mod tests {
     fn richardson_extrapolates_power_laws_and_floors_at_the_last_change() {
         let p = |h: f64| 100.0 * (1.0 + h * h);
         let h2 = hist(&[(p(1.0), 1.0), (p(0.5), 0.5)]);
-        let (e, mono, _, x) = peak_estimate(&h2, 0.0, 0.0, 2.0);
+        let (e, mono, _, x) = peak_estimate(&h2, 0.0, 2.0);
         assert!((x - 100.0).abs() < 1e-9, "{x}");
         // the last change (75) is the floor of the estimate; the extrapolation (to 100) is exact
         let exact = (p(0.5) - 100.0) / p(0.5);
@@ -496,18 +507,18 @@ mod tests {
         // a slower, linear law is observed from three values and extrapolated exactly
         let p1 = |h: f64| 100.0 * (1.0 - 0.1 * h);
         let h1 = hist(&[(p1(1.0), 1.0), (p1(0.5), 0.5), (p1(0.25), 0.25)]);
-        let (e1, _, q1, _) = peak_estimate(&h1, 0.0, 0.0, 2.0);
+        let (e1, _, q1, _) = peak_estimate(&h1, 0.0, 2.0);
         let exact1 = (100.0 - p1(0.25)) / p1(0.25);
         assert!(
             (e1 - exact1).abs() < 1e-12 && (q1 - 1.0).abs() < 1e-9,
             "{e1} vs {exact1}"
         );
-        let (_, _, _, x1) = peak_estimate(&h1, 0.0, 0.0, 2.0);
+        let (_, _, _, x1) = peak_estimate(&h1, 0.0, 2.0);
         assert!((x1 - 100.0).abs() < 1e-9, "extrapolated {x1}");
         // a faster, cubic law is not trusted beyond the theoretical order 2: conservative
         let p3 = |h: f64| 100.0 * (1.0 - h * h * h);
         let h3 = hist(&[(p3(1.0), 1.0), (p3(0.5), 0.5), (p3(0.25), 0.25)]);
-        let (e3, _, q, _) = peak_estimate(&h3, 0.0, 0.0, 2.0);
+        let (e3, _, q, _) = peak_estimate(&h3, 0.0, 2.0);
         let exact3 = (100.0 - p3(0.25)) / p3(0.25);
         assert!(
             e3 > exact3 && (q - 2.0).abs() < 1e-9,
@@ -515,12 +526,13 @@ mod tests {
         );
     }
 
-    /// A sequence that turns back is not extrapolated: the estimate is the last change.
+    /// A sequence that turns back is not extrapolated: the estimate is the spread of the last
+    /// three values.
     #[test]
     fn a_non_monotone_sequence_is_not_extrapolated() {
         let h = hist(&[(100.0, 1.0), (110.0, 0.5), (105.0, 0.25)]);
-        let (e, mono, _, _) = peak_estimate(&h, 0.5, 0.001, 2.0);
+        let (e, mono, _, _) = peak_estimate(&h, 0.5, 2.0);
         assert!(!mono);
-        assert!((e - 5.0 / 105.0).abs() < 1e-12);
+        assert!((e - 10.0 / 105.0).abs() < 1e-12);
     }
 }
