@@ -212,3 +212,54 @@ fn adaptive_peak_reaches_the_converged_reference_of_the_fillet_rod() {
         );
     }
 }
+
+/// Each triangle of `soup` split into four at its edge midpoints (float32, as an export stores
+/// them): the same surface in four times the triangles.
+fn subdivide(soup: &[[[f32; 3]; 3]]) -> Vec<[[f32; 3]; 3]> {
+    let mid = |a: [f32; 3], b: [f32; 3]| std::array::from_fn(|j| 0.5 * (a[j] + b[j]));
+    soup.iter()
+        .flat_map(|&[a, b, c]| {
+            let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
+            [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]
+        })
+        .collect()
+}
+
+#[test]
+fn a_finer_export_of_the_same_surface_gives_the_same_stress() {
+    let dir = tempfile::tempdir().unwrap();
+    let (soup, _) = read_stl_file(&root().join("designs/design2.stl")).unwrap();
+    let fine = subdivide(&subdivide(&soup));
+    assert_eq!(fine.len(), 16 * soup.len());
+    std::fs::write(dir.path().join("coarse.stl"), binary_stl(&soup)).unwrap();
+    std::fs::write(dir.path().join("fine.stl"), binary_stl(&fine)).unwrap();
+    let config = StudyConfig::default();
+    let mode = MeshMode::Fixed(5.0);
+    let coarse = fem(dir.path(), "coarse", &config, &mode);
+    let finer = fem(dir.path(), "fine", &config, &mode);
+    let [export_c, meshed_c] = coarse.mesh.surface_triangles;
+    let [export_f, meshed_f] = finer.mesh.surface_triangles;
+    eprintln!("triangles: export {export_c} → {meshed_c}, 16× export {export_f} → {meshed_f}");
+    // the simplification gives gmsh about the same surface (the subdivision points all go; the
+    // guard against new slivers keeps a few more triangles than the coarse export's own)
+    assert!(
+        (meshed_f as f64) < 1.3 * meshed_c as f64,
+        "{meshed_f} vs {meshed_c}"
+    );
+    for (a, b, case) in [
+        (&coarse.fem.fx, &finer.fem.fx, "fx"),
+        (&coarse.fem.fy, &finer.fem.fy, "fy"),
+    ] {
+        let (sa, sb) = (
+            a.max_von_mises_away_from_fixed_mpa,
+            b.max_von_mises_away_from_fixed_mpa,
+        );
+        let diff = (sa - sb).abs() / sa;
+        let bar = a.estimated_error_rel + b.estimated_error_rel;
+        eprintln!("{case}: {sb:.2} vs {sa:.2} MPa ({diff:.1e}; error bars {bar:.3})");
+        assert!(
+            diff <= bar,
+            "{case}: {sb} vs {sa} MPa beyond the error bars {bar}"
+        );
+    }
+}

@@ -319,7 +319,7 @@ pub fn adaptive_rod(
         };
         let new_sizes = if stop.is_none() {
             Some(refine_sizes(
-                &mesh, &sol, &sizes, &elems_of, &estimates, band, &targets, opts, floor,
+                &mesh, &sol, &sizes, &elems_of, &estimates, &targets, opts, floor,
             ))
         } else {
             None
@@ -341,7 +341,7 @@ pub fn adaptive_rod(
         // DOF cap on the predicted next mesh
         let mut new_sizes = new_sizes;
         if let Some(ns) = &mut new_sizes {
-            let predicted = predicted_dofs(&mesh, &sizes, &elems_of, ns);
+            let predicted = predicted_dofs(&mesh, &sizes, ns);
             if predicted > opts.max_dofs as f64 {
                 if mesh.n_dofs() as f64 >= 0.8 * opts.max_dofs as f64 {
                     stop = Some(StopReason::DofCap);
@@ -402,7 +402,7 @@ fn nearest_node(mesh: &TetMesh, p: [f64; 3]) -> usize {
 
 /// DOFs of a mesh with the sizes `nodal` (per node) predicted from the current one: each
 /// element becomes (h_e / h_new)³ elements.
-fn predicted_dofs(mesh: &TetMesh, sizes: &[f64], _elems_of: &[Vec<u32>], nodal: &[f64]) -> f64 {
+fn predicted_dofs(mesh: &TetMesh, sizes: &[f64], nodal: &[f64]) -> f64 {
     let per_element = mesh.n_dofs() as f64 / mesh.n_elements() as f64;
     mesh.elements()
         .iter()
@@ -422,7 +422,6 @@ fn refine_sizes(
     sizes: &[f64],
     elems_of: &[Vec<u32>],
     estimates: &[f64; 2],
-    _band: f64,
     targets: &[f64; 2],
     opts: &AdaptOptions,
     floor: &(dyn Fn([f64; 3]) -> f64 + Sync),

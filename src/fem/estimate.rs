@@ -3,9 +3,9 @@
 //! indicator for the von Mises stress, and an estimate of the error of the peak.
 //!
 //! * **Energy norm** (ZZ 1987, IJNME 24; ZZ 1992 Part 2): per element
-//!   η_e² = ∫_e (σ* − σ_h)ᵀ C⁻¹ (σ* − σ_h) dV, with C⁻¹ the isotropic compliance
-//!   (Δσᵀ C⁻¹ Δσ = [Σ Δσ_ii² − 2ν (Δσ_xx Δσ_yy + Δσ_yy Δσ_zz + Δσ_zz Δσ_xx)] / E
-//!   + (Δσ_xy² + Δσ_yz² + Δσ_zx²) / G), integrated with the 14-point degree-5 rule (exact for
+//!   η_e² = ∫_e (σ* − σ_h)ᵀ C⁻¹ (σ* − σ_h) dV, with C⁻¹ the isotropic compliance,
+//!   Δσᵀ C⁻¹ Δσ = [Σ Δσ_ii² − 2ν (Δσ_xx Δσ_yy + Δσ_yy Δσ_zz + Δσ_zz Δσ_xx)] / E plus
+//!   (Δσ_xy² + Δσ_yz² + Δσ_zx²) / G, integrated with the 14-point degree-5 rule (exact for
 //!   a straight element: σ* is quadratic, σ_h linear). The relative error
 //!   η / (‖σ*‖² + η²)^½ is what CalculiX's ERR and Abaqus' energy-norm indicators report.
 //! * **Pointwise, for the von Mises stress**: von Mises is a seminorm of the stress tensor

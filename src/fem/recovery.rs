@@ -58,8 +58,8 @@ impl RecoveredStress {
         let el = &mesh.elements()[e];
         let mut s = [0.0; 6];
         for a in 0..10 {
-            for c in 0..6 {
-                s[c] += n[a] * self.nodal[el[a]][c];
+            for (c, v) in s.iter_mut().enumerate() {
+                *v += n[a] * self.nodal[el[a]][c];
             }
         }
         s
@@ -72,8 +72,11 @@ struct Samples {
     stress: Vec<[[f64; 6]; 4]>,
 }
 
+/// The four Gauss points of one element and σ_h there.
+type ElementSamples = ([[f64; 3]; 4], [[f64; 6]; 4]);
+
 fn gauss_samples(mesh: &TetMesh, material: &Material, u: &[f64]) -> Result<Samples> {
-    let per: Vec<([[f64; 3]; 4], [[f64; 6]; 4])> = (0..mesh.n_elements())
+    let per: Vec<ElementSamples> = (0..mesh.n_elements())
         .into_par_iter()
         .map(|e| {
             let x: ElementCoords = mesh.element_coords(e);
@@ -158,7 +161,7 @@ fn fit(
     let (lo, hi) = eig.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &v| {
         (lo.min(v), hi.max(v))
     });
-    if !(lo > 1e-10 * hi) {
+    if lo.is_nan() || lo <= 1e-10 * hi {
         return None;
     }
     let chol = a.cholesky()?;
@@ -326,12 +329,10 @@ mod tests {
             ];
             let s = m.stress(&e);
             let scale = s.iter().map(|v| v.abs()).fold(1e6, f64::max);
-            for c in 0..6 {
+            for (c, (got, want)) in rec.nodal[n].iter().zip(&s).enumerate() {
                 assert!(
-                    (rec.nodal[n][c] - s[c]).abs() < 1e-9 * scale,
-                    "node {n} comp {c}: {} vs {}",
-                    rec.nodal[n][c],
-                    s[c]
+                    (got - want).abs() < 1e-9 * scale,
+                    "node {n} comp {c}: {got} vs {want}"
                 );
             }
         }

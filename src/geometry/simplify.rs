@@ -65,7 +65,7 @@ impl PartialOrd for Candidate {
 fn plane_quadric(a: Vector3<f64>, b: Vector3<f64>, c: Vector3<f64>) -> Option<Matrix4<f64>> {
     let n = (b - a).cross(&(c - a));
     let len = n.norm();
-    if !(len > 0.0) {
+    if len.is_nan() || len <= 0.0 {
         return None;
     }
     let n = n / len;
