@@ -2,7 +2,7 @@
 //! [--refine 8,5,3.5]`
 
 use crate::fem::study::refinement_study_stl;
-use crate::fem::{BoreSpec, Material, RodOptions};
+use crate::fem::{Material, RodOptions};
 use crate::geometry::design::mass_of_design;
 use crate::mechanism::Method;
 use crate::python_env::{pipeline_script, python};
@@ -248,11 +248,7 @@ fn print_result(d: &DesignFem) {
 fn refine(args: &FemArgs, config: &StudyConfig, force: f64, sizes: &[f64]) -> Result<i32> {
     // meshed in the rod frame, mm, as stage 3 meshes (any units and pose)
     let surface = rod_frame_surface(&args.design, &args.out.join("refinement"))?;
-    let bores = BoreSpec::from_mm(
-        [0.0, 0.0, 0.0],
-        [surface.centre_distance_mm, 0.0, 0.0],
-        [0.0, 0.0, 1.0],
-    );
+    let bores = surface.bores();
     let material = Material {
         youngs_modulus_pa: config.fem.youngs_modulus_pa,
         poisson_ratio: config.fem.poisson_ratio,

@@ -16,6 +16,18 @@ use super::stress::point_triangle_distance;
 /// Dihedral angle below which two facets count as coplanar (a subdivided flat face), degrees.
 pub const FLAT_DEG: f64 = 0.5;
 
+/// The facets on each edge (vertex pair, smaller index first).
+fn edge_faces(triangles: &[[u32; 3]]) -> HashMap<(u32, u32), Vec<u32>> {
+    let mut out: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
+    for (f, t) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            out.entry((a.min(b), a.max(b))).or_default().push(f as u32);
+        }
+    }
+    out
+}
+
 /// Facet spacing on the curved parts of a triangulated surface, looked up by position.
 #[derive(Clone, Debug)]
 pub struct FacetScale {
@@ -51,16 +63,7 @@ impl FacetScale {
             let l = norm(n);
             (n.map(|v| v / l), 0.5 * l)
         };
-        let mut edge_faces: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
-        for (f, t) in triangles.iter().enumerate() {
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                edge_faces
-                    .entry((a.min(b), a.max(b)))
-                    .or_default()
-                    .push(f as u32);
-            }
-        }
+        let edge_faces = edge_faces(triangles);
         let (lo, hi) = (FLAT_DEG.to_radians().cos(), feature_deg.to_radians().cos());
         let mut spacing = vec![f64::INFINITY; triangles.len()];
         for ((a, b), faces) in &edge_faces {
@@ -203,16 +206,7 @@ pub fn reentrant_edges(
     triangles: &[[u32; 3]],
     feature_deg: f64,
 ) -> Vec<[[f64; 3]; 2]> {
-    let mut edge_faces: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
-    for (f, t) in triangles.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            edge_faces
-                .entry((a.min(b), a.max(b)))
-                .or_default()
-                .push(f as u32);
-        }
-    }
+    let edge_faces = edge_faces(triangles);
     let cos_feature = feature_deg.to_radians().cos();
     let mut out = Vec::new();
     for ((a, b), faces) in &edge_faces {

@@ -151,17 +151,40 @@ pub fn displacement_magnitudes(u: &[f64]) -> Vec<f64> {
 /// Per node: true when its distance to the surface made of the corner triangles of `faces` is at
 /// least `band` (m).
 pub fn nodes_away_from(mesh: &TetMesh, faces: &[[usize; 6]], band: f64) -> Vec<bool> {
-    if faces.is_empty() || band.is_nan() || band <= 0.0 {
+    let corners = |i: usize| {
+        let f = &faces[i];
+        [mesh.nodes()[f[0]], mesh.nodes()[f[1]], mesh.nodes()[f[2]]]
+    };
+    nodes_away_from_shapes(
+        mesh,
+        faces.len(),
+        band,
+        |i| corners(i).to_vec(),
+        |p, i| point_triangle_distance(p, corners(i)),
+    )
+}
+
+/// Per node: true when it is at least `band` (m) from each of `n` shapes, given the points that
+/// bound shape i (its bounding box is theirs) and the distance from a point to it. Shapes are
+/// binned on a grid of spacing `band`, so each node tests only the shapes in its cell.
+fn nodes_away_from_shapes(
+    mesh: &TetMesh,
+    n: usize,
+    band: f64,
+    points: impl Fn(usize) -> Vec<[f64; 3]>,
+    distance: impl Fn([f64; 3], usize) -> f64 + Sync,
+) -> Vec<bool> {
+    if n == 0 || band.is_nan() || band <= 0.0 {
         return vec![true; mesh.n_nodes()];
     }
     let cell = |p: [f64; 3]| p.map(|v| (v / band).floor() as i64);
     let mut grid: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
-    for (i, f) in faces.iter().enumerate() {
+    for i in 0..n {
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-        for &n in &f[..3] {
+        for q in points(i) {
             for j in 0..3 {
-                lo[j] = lo[j].min(mesh.nodes()[n][j] - band);
-                hi[j] = hi[j].max(mesh.nodes()[n][j] + band);
+                lo[j] = lo[j].min(q[j] - band);
+                hi[j] = hi[j].max(q[j] + band);
             }
         }
         let (a, b) = (cell(lo), cell(hi));
@@ -176,13 +199,8 @@ pub fn nodes_away_from(mesh: &TetMesh, faces: &[[usize; 6]], band: f64) -> Vec<b
     mesh.nodes()
         .par_iter()
         .map(|p| {
-            grid.get(&cell(*p)).is_none_or(|list| {
-                list.iter().all(|&i| {
-                    let f = &faces[i];
-                    let t = [mesh.nodes()[f[0]], mesh.nodes()[f[1]], mesh.nodes()[f[2]]];
-                    point_triangle_distance(*p, t) >= band
-                })
-            })
+            grid.get(&cell(*p))
+                .is_none_or(|list| list.iter().all(|&i| distance(*p, i) >= band))
         })
         .collect()
 }
@@ -234,32 +252,13 @@ pub fn nodes_away_from_segments(
     segments: &[[[f64; 3]; 2]],
     band: f64,
 ) -> Vec<bool> {
-    if segments.is_empty() || band.is_nan() || band <= 0.0 {
-        return vec![true; mesh.n_nodes()];
-    }
-    let cell = |p: [f64; 3]| p.map(|v| (v / band).floor() as i64);
-    let mut grid: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
-    for (i, s) in segments.iter().enumerate() {
-        let lo: [f64; 3] = std::array::from_fn(|j| s[0][j].min(s[1][j]) - band);
-        let hi: [f64; 3] = std::array::from_fn(|j| s[0][j].max(s[1][j]) + band);
-        let (a, b) = (cell(lo), cell(hi));
-        for x in a[0]..=b[0] {
-            for y in a[1]..=b[1] {
-                for z in a[2]..=b[2] {
-                    grid.entry([x, y, z]).or_default().push(i);
-                }
-            }
-        }
-    }
-    mesh.nodes()
-        .par_iter()
-        .map(|p| {
-            grid.get(&cell(*p)).is_none_or(|list| {
-                list.iter()
-                    .all(|&i| point_segment_distance(*p, segments[i]) >= band)
-            })
-        })
-        .collect()
+    nodes_away_from_shapes(
+        mesh,
+        segments.len(),
+        band,
+        |i| segments[i].to_vec(),
+        |p, i| point_segment_distance(p, segments[i]),
+    )
 }
 
 /// Distance from `p` to the segment `s`.

@@ -163,6 +163,17 @@ pub struct RodFrameSurface {
 /// size, above the float32 noise of a millimetre export).
 pub const SIMPLIFY_TOLERANCE_MM: f64 = 0.005;
 
+impl RodFrameSurface {
+    /// The pin axes in the rod frame: A at the origin, B at (l, 0, 0), along z.
+    pub fn bores(&self) -> BoreSpec {
+        BoreSpec::from_mm(
+            [0.0, 0.0, 0.0],
+            [self.centre_distance_mm, 0.0, 0.0],
+            [0.0, 0.0, 1.0],
+        )
+    }
+}
+
 /// Writes `work_dir/rod_frame.stl`: the validated surface of `stl` in the rod frame, mm.
 pub fn rod_frame_surface(stl: &Path, work_dir: &Path) -> Result<RodFrameSurface> {
     use sha2::Digest;
@@ -215,11 +226,7 @@ pub fn fem_of_design(
     let python = python().with_context(context)?;
     let script = pipeline_script(MESHER);
     let surface = rod_frame_surface(stl, work_dir).with_context(context)?;
-    let bores = BoreSpec::from_mm(
-        [0.0, 0.0, 0.0],
-        [surface.centre_distance_mm, 0.0, 0.0],
-        [0.0, 0.0, 1.0],
-    );
+    let bores = surface.bores();
     let material = Material {
         youngs_modulus_pa: config.fem.youngs_modulus_pa,
         poisson_ratio: config.fem.poisson_ratio,
