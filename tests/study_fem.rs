@@ -76,6 +76,28 @@ fn study_runs_stage_3_and_ranks_by_the_criterion_first() {
             fem["force_n"].as_f64(),
             d["dynamics"]["peak_pin_force_n"].as_f64()
         );
+        // the model says where it is out of its depth: above yield, or displacements above 1 %
+        // of the 180 mm centre distance
+        let validity: Vec<&str> = c["model_validity"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_str().unwrap())
+            .collect();
+        let displacement = fem["fem"]["fx"]["max_displacement_mm"]
+            .as_f64()
+            .unwrap()
+            .max(fem["fem"]["fy"]["max_displacement_mm"].as_f64().unwrap());
+        assert_eq!(
+            validity.iter().any(|v| v.starts_with("beyond yield")),
+            fx.max(fy) > 355.0,
+            "{id}: {validity:?}"
+        );
+        assert_eq!(
+            validity.iter().any(|v| v.starts_with("large displacement")),
+            displacement > 1.8,
+            "{id}: {validity:?}"
+        );
         let force = d["dynamics"]["peak_pin_force_n"].as_f64().unwrap();
         verdicts.insert(id, (c["pass"].as_bool().unwrap(), fy, force));
     }
@@ -110,4 +132,10 @@ fn study_runs_stage_3_and_ranks_by_the_criterion_first() {
     let p2 = md.find("Design 2").unwrap();
     let p5 = md.find("Design 5").unwrap();
     assert!(p2 < p5, "{md}");
+    // design 5's slender shank: beyond yield and beyond small displacements, said in the ranking
+    assert!(
+        md.contains("fail (beyond yield; large displacement)"),
+        "{md}"
+    );
+    assert!(md.contains("## Out of the model's depth"), "{md}");
 }

@@ -104,6 +104,10 @@ pub struct StressVerdict {
     /// yield / governing stress.
     pub safety_factor: f64,
     pub pass: bool,
+    /// Where the linear, small-displacement model is out of its depth (peak above yield,
+    /// displacement above 1 % of the centre distance); empty when it is not.
+    #[serde(default)]
+    pub model_validity: Vec<String>,
 }
 
 /// The stage-3 record of one design.
@@ -399,7 +403,7 @@ pub fn fem_of_design(
             (out.solution.result, summary)
         }
     };
-    let criterion = verdict(&fem, config);
+    let criterion = verdict(&fem, config, surface.centre_distance_mm);
     Ok(DesignFem {
         force_n,
         mesh: summary,
@@ -408,9 +412,16 @@ pub fn fem_of_design(
     })
 }
 
+/// Displacements above this fraction of the centre distance are beyond small-displacement
+/// theory (1 %: the rotation of the shank then changes the load path by more than the target
+/// accuracy of the stress, 3 %, for a lever of about a third of the rod).
+pub const LARGE_DISPLACEMENT_FRACTION: f64 = 0.01;
+
 /// Judges the stress criterion on the convergent measure (plus its estimated error when the
-/// configuration asks for it).
-pub fn verdict(fem: &FemResult, config: &StudyConfig) -> StressVerdict {
+/// configuration asks for it), and says where the linear, small-displacement model is out of its
+/// depth: a peak above yield, a displacement above [`LARGE_DISPLACEMENT_FRACTION`] of the centre
+/// distance `centre_distance_mm`.
+pub fn verdict(fem: &FemResult, config: &StudyConfig, centre_distance_mm: f64) -> StressVerdict {
     let allowed = config.criterion.yield_mpa / config.criterion.safety_factor;
     let with_error = config.criterion.with_error;
     let judged = |c: &crate::fem::LoadCaseResult| {
@@ -427,7 +438,27 @@ pub fn verdict(fem: &FemResult, config: &StudyConfig) -> StressVerdict {
     } else {
         (fx, "fx", fem.fx.estimated_error_rel)
     };
+    let peak = fem
+        .fx
+        .max_von_mises_away_from_fixed_mpa
+        .max(fem.fy.max_von_mises_away_from_fixed_mpa);
+    let displacement = fem.fx.max_displacement_mm.max(fem.fy.max_displacement_mm);
+    let mut model_validity = Vec::new();
+    if peak > config.criterion.yield_mpa {
+        model_validity.push(format!(
+            "beyond yield: the peak, {peak:.0} MPa, exceeds the yield stress ({:.0} MPa); a linear-elastic model does not describe this load (the part would yield first)",
+            config.criterion.yield_mpa
+        ));
+    }
+    if displacement > LARGE_DISPLACEMENT_FRACTION * centre_distance_mm {
+        model_validity.push(format!(
+            "large displacement: {displacement:.2} mm is {:.2} % of the centre distance (above {:.0} %), beyond small-displacement theory",
+            100.0 * displacement / centre_distance_mm,
+            100.0 * LARGE_DISPLACEMENT_FRACTION
+        ));
+    }
     StressVerdict {
+        model_validity,
         allowed_mpa: allowed,
         governing_mpa: governing,
         governing_case: case.into(),

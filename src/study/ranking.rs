@@ -43,6 +43,8 @@ struct Row<'a> {
     allowed_mpa: Option<f64>,
     safety_factor: Option<f64>,
     status: &'static str,
+    /// Where the linear model is out of its depth (beyond yield, large displacement), `; `-joined.
+    model_validity: String,
 }
 
 fn rows(results: &StudyResults) -> Vec<Row<'_>> {
@@ -83,6 +85,16 @@ fn rows(results: &StudyResults) -> Vec<Row<'_>> {
                     Some(f) if f.criterion.pass => "pass",
                     Some(_) => "fail",
                 },
+                model_validity: f
+                    .map(|f| {
+                        f.criterion
+                            .model_validity
+                            .iter()
+                            .map(|m| m.split(':').next().unwrap_or_default())
+                            .collect::<Vec<_>>()
+                            .join("; ")
+                    })
+                    .unwrap_or_default(),
             }
         })
         .collect()
@@ -143,8 +155,32 @@ pub fn markdown(results: &StudyResults) -> String {
             r.max_displacement_mm
                 .map_or("—".into(), |v| format!("{v:.4}")),
             r.safety_factor.map_or("—".into(), |v| format!("{v:.2}")),
-            r.status
+            if r.model_validity.is_empty() {
+                r.status.to_string()
+            } else {
+                format!("{} ({})", r.status, r.model_validity)
+            }
         ));
+    }
+    let notes: Vec<String> = results
+        .designs
+        .iter()
+        .filter_map(|d| d.fem.as_ref().map(|f| (d, f)))
+        .flat_map(|(d, f)| {
+            f.criterion
+                .model_validity
+                .iter()
+                .map(move |m| format!("- {}: {m}", d.mass.design))
+        })
+        .collect();
+    if !notes.is_empty() {
+        out.push_str(
+            "\n## Out of the model's depth\n\nThe stage-3 model is linear elastic and small-displacement; these figures are beyond it (the verdict stands, the numbers are not to be read as the part's stress or deflection):\n\n",
+        );
+        for n in notes {
+            out.push_str(&n);
+            out.push('\n');
+        }
     }
     if !results.failed.is_empty() {
         out.push_str("\n## Failed designs\n\n");
