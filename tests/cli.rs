@@ -108,3 +108,30 @@ fn missing_paths_and_interpreters_are_clear_errors() {
         "{e}"
     );
 }
+
+/// Issue 13 item 2: the default step cap grows with the simulated time, so a 100 s run at
+/// 1e-12 (2.8 million RK45 steps, more than the old fixed cap of a million) finishes; an explicit
+/// `--max-steps` is still a total and stops it with the step-limit message.
+#[test]
+fn long_free_run_finishes_under_the_default_cap() {
+    let args = [
+        "dynamics", "free", "--method", "rk45", "--rtol", "1e-12", "--atol", "1e-12", "--t-end",
+        "100", "--json",
+    ];
+    let o = rodstudy(&args, &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(v["steps"].as_u64().unwrap() > 1_000_000, "{v}");
+    assert_eq!(v["t_end_s"].as_f64(), Some(100.0));
+    // φ(100 s) against the energy-integral reference (independent of the integrator): φ reaches
+    // 1.8e5 rad, so 2.8e6 steps accumulate about 2.2e-16 × 1.8e5 × 2.8e6 ≈ 1e-4 rad of rounding
+    // (measured 4.8e-4 rad, 2.7e-9 of φ)
+    let err = v["max_err_phi_rad"].as_f64().unwrap();
+    let phi = v["phi_rad"].as_f64().unwrap();
+    assert!((phi / 180_408.410_63 - 1.0).abs() < 1e-8, "φ(100 s) = {phi}");
+    assert!(err / phi < 1e-8, "max |Δφ| = {err} rad");
+    let capped = rodstudy(&[&args[..10], &["--max-steps", "1000000"]].concat(), &[]);
+    assert!(!capped.status.success());
+    let msg = String::from_utf8_lossy(&capped.stderr);
+    assert!(msg.contains("step limit of 1000000 steps"), "{msg}");
+}

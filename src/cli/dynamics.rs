@@ -81,7 +81,7 @@ pub struct FreeArgs {
     /// End time [s] (default 1).
     #[arg(long)]
     t_end: Option<f64>,
-    /// Cap on steps (default 1e6).
+    /// Cap on steps, in all (default: 1e6 per second of simulated time, at least 1e6).
     #[arg(long)]
     max_steps: Option<u64>,
     /// Print the result as JSON (without the trajectories).
@@ -124,6 +124,8 @@ fn free(args: FreeArgs) -> Result<i32> {
     options.rtol = args.rtol.unwrap_or(options.rtol);
     options.atol = args.atol.unwrap_or(options.atol);
     options.fixed_step = args.dt.unwrap_or(options.fixed_step);
+    // the default caps grow with the simulated time; an explicit --max-steps is a total
+    options = options.with_caps_for_duration();
     options.max_steps = args.max_steps.unwrap_or(options.max_steps);
     let run = run_free(method, &options).map_err(|e| anyhow::anyhow!("{method}: {e}"))?;
     let errors = options
