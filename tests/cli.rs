@@ -128,7 +128,10 @@ fn long_free_run_finishes_under_the_default_cap() {
     // (measured 4.8e-4 rad, 2.7e-9 of φ)
     let err = v["max_err_phi_rad"].as_f64().unwrap();
     let phi = v["phi_rad"].as_f64().unwrap();
-    assert!((phi / 180_408.410_63 - 1.0).abs() < 1e-8, "φ(100 s) = {phi}");
+    assert!(
+        (phi / 180_408.410_63 - 1.0).abs() < 1e-8,
+        "φ(100 s) = {phi}"
+    );
     assert!(err / phi < 1e-8, "max |Δφ| = {err} rad");
     let capped = rodstudy(&[&args[..10], &["--max-steps", "1000000"]].concat(), &[]);
     assert!(!capped.status.success());

@@ -37,8 +37,14 @@ fn assert_methods_agree(
         "rod {rod:?}, gravity {}: {a:?}",
         params.gravity
     );
-    // both report the same refined and grid peaks
-    assert_eq!(test.peak_pin_force_n, reference.peak_pin_force_n);
+    // each refines its peak on its own model (issue 13 item 3): they agree to the same tolerance
+    assert!(
+        (test.peak_pin_force_n - reference.peak_pin_force_n).abs()
+            <= tol * reference.peak_pin_force_n,
+        "refined peaks {} vs {} N",
+        test.peak_pin_force_n,
+        reference.peak_pin_force_n
+    );
     assert!(
         (test.grid_peak_pin_force_n - reference.grid_peak_pin_force_n).abs()
             <= tol * reference.grid_peak_pin_force_n

@@ -9,7 +9,8 @@
 //! to a bracket of 1e-10 of the period (the force is flat at its maximum, so
 //! its value is then exact to rounding). About 480 closed-form evaluations,
 //! a few tens of microseconds. The reported time is the first occurrence in
-//! [0, period).
+//! [0, period). [`refine_peak_of`] does the same on any model of the motion
+//! (the multibody core, for `--method multibody`).
 
 use super::crank_slider::CrankSlider;
 use super::error::{DynamicsError, Result};
@@ -83,17 +84,34 @@ pub fn refine_peak(
     omega_rad_s: f64,
     duration_s: f64,
 ) -> Result<PeakRefinement> {
+    let motion = CrankMotion::ConstantSpeed {
+        phi0_rad,
+        omega_rad_s,
+    };
+    refine_peak_of(
+        |t: f64| model.closed_form(motion.sample(t)).f_a.norm(),
+        phi0_rad,
+        omega_rad_s,
+        duration_s,
+    )
+}
+
+/// [`refine_peak`] for any model of the motion: `f(t)` is |F_A| at time t (NaN for a failure,
+/// which makes the result an error). The scan runs forwards in t and the golden-section brackets
+/// are narrow, so a model that tracks its solution from the previous time (the multibody core)
+/// can be used as it is.
+pub fn refine_peak_of(
+    mut f: impl FnMut(f64) -> f64,
+    phi0_rad: f64,
+    omega_rad_s: f64,
+    duration_s: f64,
+) -> Result<PeakRefinement> {
     if !(omega_rad_s.is_finite() && omega_rad_s > 0.0 && duration_s.is_finite() && duration_s > 0.0)
     {
         return Err(DynamicsError::InvalidScene(format!(
             "peak refinement needs omega > 0 and duration > 0 (got {omega_rad_s} rad/s, {duration_s} s)"
         )));
     }
-    let motion = CrankMotion::ConstantSpeed {
-        phi0_rad,
-        omega_rad_s,
-    };
-    let f = |t: f64| model.closed_form(motion.sample(t)).f_a.norm();
     let period = std::f64::consts::TAU / omega_rad_s;
     let periodic = duration_s >= period;
     let window = if periodic { period } else { duration_s };
@@ -137,7 +155,7 @@ pub fn refine_peak(
             a = a.max(0.0);
             b = b.min(duration_s);
         }
-        let (tg, fg, n) = golden_section_max(f, a, b, 1e-10 * window);
+        let (tg, fg, n) = golden_section_max(&mut f, a, b, 1e-10 * window);
         evaluations += n;
         let (tc, fc) = if fg > vi { (tg, fg) } else { (ti, vi) };
         if fc > f_best {
