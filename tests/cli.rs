@@ -138,3 +138,65 @@ fn long_free_run_finishes_under_the_default_cap() {
     let msg = String::from_utf8_lossy(&capped.stderr);
     assert!(msg.contains("step limit of 1000000 steps"), "{msg}");
 }
+
+/// Issue 13 item 1: `rodstudy mass` gives the mass properties of any closed solid; without bores
+/// at the pins the mechanism-frame fields are null with a warning, and the study still refuses it.
+#[test]
+fn mass_of_a_plain_box_without_bores() {
+    use nalgebra::Vector3;
+    use rodstudy::geometry::primitives::cuboid;
+    let dir = tempfile::tempdir().unwrap();
+    // 50 × 40 × 30 mm, centred at (10, 0, 0) mm: the default crank pin (0, 0, 0) is inside it
+    let b = cuboid(Vector3::new(50.0, 40.0, 30.0), Vector3::new(10.0, 0.0, 0.0));
+    std::fs::write(dir.path().join("box.stl"), binary_stl(&to_soup(&b))).unwrap();
+    let out = rodstudy(&["mass", "--json", dir.path().to_str().unwrap()], &[]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let r = &v[0];
+    // closed forms: V = abc, m = ρV, I_xx = m (b² + c²) / 12 about the centroid
+    let (a, bb, c) = (0.05, 0.04, 0.03);
+    let m = 7800.0 * a * bb * c;
+    assert!((r["volume_m3"].as_f64().unwrap() / (a * bb * c) - 1.0).abs() < 1e-6);
+    assert!((r["mass_kg"].as_f64().unwrap() / m - 1.0).abs() < 1e-6);
+    let ixx = r["inertia_about_centroid_kgm2"][0][0].as_f64().unwrap();
+    assert!(
+        (ixx / (m * (bb * bb + c * c) / 12.0) - 1.0).abs() < 1e-6,
+        "{ixx}"
+    );
+    assert!((r["centroid_m"][0].as_f64().unwrap() - 0.01).abs() < 1e-9);
+    for key in ["l1_m", "i_zz_kgm2", "i_xx_kgm2", "crank_bore_radius_m"] {
+        assert!(r[key].is_null(), "{key}: {}", r[key]);
+    }
+    let warnings = r["warnings"].to_string();
+    assert!(
+        warnings.contains("no mechanism-frame properties") && warnings.contains("inside material"),
+        "{warnings}"
+    );
+    // the table shows the mass and "—" for the rod figures
+    let table = rodstudy(&["mass", dir.path().to_str().unwrap()], &[]);
+    let text = String::from_utf8_lossy(&table.stdout);
+    assert!(
+        text.contains("| box | 0.468000 |") && text.contains("| — |"),
+        "{text}"
+    );
+    // the study needs the pins in bores: refused with the message of before
+    let out_dir = tempfile::tempdir().unwrap();
+    let study = rodstudy(
+        &[
+            "study",
+            "--skip-fem",
+            "--designs",
+            dir.path().to_str().unwrap(),
+            "--out",
+            out_dir.path().to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert!(!study.status.success());
+    let msg = String::from_utf8_lossy(&study.stderr);
+    assert!(msg.contains("lies inside material, not in a bore"), "{msg}");
+}

@@ -1,6 +1,6 @@
 //! `rodstudy mass PATH... [--json]`
 
-use crate::geometry::design::{DesignMass, find_stl_files, mass_of_design};
+use crate::geometry::design::{DesignMass, find_stl_files, mass_of_solid};
 use crate::study::tables::mass_table;
 use anyhow::Result;
 use clap::Args;
@@ -22,7 +22,7 @@ pub fn run(args: MassArgs) -> Result<i32> {
     let results: Vec<(PathBuf, Result<DesignMass>)> = files
         .into_par_iter()
         .map(|f| {
-            let r = mass_of_design(&f);
+            let r = mass_of_solid(&f);
             (f, r)
         })
         .collect();

@@ -105,9 +105,33 @@ pub fn load_design(stl: &Path) -> Result<LoadedDesign> {
     })
 }
 
-/// Stage 1 for one file: [`load_design`], the bore check, and the report record.
+/// Stage 1 for one file: [`load_design`], the bore check, and the report record. A solid whose
+/// pins do not sit in bores is an error (the mechanism needs them).
 pub fn mass_of_design(stl: &Path) -> Result<DesignMass> {
     let d = load_design(stl)?;
+    rod_record(&d, stl)
+}
+
+/// Stage 1 for any closed solid (`rodstudy mass`): the mass properties always; the
+/// mechanism-frame fields (l1, offsets, I_zz, I_xx, I_yy, centre distance, bore radii) are NaN,
+/// written as JSON `null`, with a warning saying why, when the pins do not sit in bores.
+/// File and surface defects are still errors.
+pub fn mass_of_solid(stl: &Path) -> Result<DesignMass> {
+    let d = load_design(stl)?;
+    match rod_record(&d, stl) {
+        Ok(r) => Ok(r),
+        Err(e) => {
+            let mut r = record(&d, stl, None);
+            r.warnings.push(format!(
+                "no mechanism-frame properties (l1, I_zz, I_xx, bores: null): {e:#}"
+            ));
+            Ok(r)
+        }
+    }
+}
+
+/// The bore check and the mechanism frame of a loaded design.
+fn rod_record(d: &LoadedDesign, stl: &Path) -> Result<DesignMass> {
     let surface = RodSurface::new(&d.mesh).with_context(|| stl.display().to_string())?;
     let scale = d.settings.units.to_metres();
     let units = d.settings.units.symbol();
@@ -127,9 +151,20 @@ pub fn mass_of_design(stl: &Path) -> Result<DesignMass> {
             rod.centre_distance_m
         );
     }
+    Ok(record(d, stl, Some((rod, crank_bore, piston_bore))))
+}
+
+/// The record; the mechanism-frame fields NaN when `rod` is `None`.
+fn record(d: &LoadedDesign, stl: &Path, rod: Option<(RodInFrame, f64, f64)>) -> DesignMass {
     let m = &d.mass;
-    Ok(DesignMass {
-        design: d.name,
+    let nan = f64::NAN;
+    let (rod, crank_bore, piston_bore) = match rod {
+        Some((r, a, b)) => (Some(r), a, b),
+        None => (None, nan, nan),
+    };
+    let pick = |f: fn(&RodInFrame) -> f64| rod.as_ref().map_or(nan, f);
+    DesignMass {
+        design: d.name.clone(),
         id: stl
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
@@ -138,7 +173,7 @@ pub fn mass_of_design(stl: &Path) -> Result<DesignMass> {
         format: format!("{:?}", d.format).to_lowercase(),
         triangles: d.mesh.triangles.len(),
         vertices: d.mesh.vertices.len(),
-        units: units.to_string(),
+        units: d.settings.units.symbol().to_string(),
         density_kg_m3: d.settings.density,
         volume_m3: m.volume,
         mass_kg: m.mass,
@@ -146,17 +181,17 @@ pub fn mass_of_design(stl: &Path) -> Result<DesignMass> {
         inertia_about_centroid_kgm2: m.inertia.transpose().into(),
         principal_moments_kgm2: m.principal_moments.into(),
         principal_axes: m.principal_axes.into(),
-        l1_m: rod.l1_m,
-        offset_m: rod.offset_m,
-        offset_z_m: rod.offset_z_m,
-        i_zz_kgm2: rod.i_zz_kgm2,
-        i_xx_kgm2: rod.i_xx_kgm2,
-        i_yy_kgm2: rod.i_yy_kgm2,
-        centre_distance_m: rod.centre_distance_m,
+        l1_m: pick(|r| r.l1_m),
+        offset_m: pick(|r| r.offset_m),
+        offset_z_m: pick(|r| r.offset_z_m),
+        i_zz_kgm2: pick(|r| r.i_zz_kgm2),
+        i_xx_kgm2: pick(|r| r.i_xx_kgm2),
+        i_yy_kgm2: pick(|r| r.i_yy_kgm2),
+        centre_distance_m: pick(|r| r.centre_distance_m),
         crank_bore_radius_m: crank_bore,
         piston_bore_radius_m: piston_bore,
-        warnings: d.warnings,
-    })
+        warnings: d.warnings.clone(),
+    }
 }
 
 /// The STL files named by `paths`: files as given, folders searched (not recursively) for

@@ -7,18 +7,26 @@ pub fn mass_table(designs: &[&DesignMass]) -> String {
     let mut out = String::from(
         "| design | mass [kg] | volume [cm³] | l1 [mm] | offset [mm] | I_zz pin axis [kg·m²] | I_xx long axis [kg·m²] | bores A / B [mm] | triangles |\n|---|---|---|---|---|---|---|---|---|\n",
     );
+    // the mechanism-frame figures of a solid without bores are NaN: shown as "—"
+    let num = |v: f64, f: &dyn Fn(f64) -> String| if v.is_finite() { f(v) } else { "—".into() };
     for d in designs {
         out.push_str(&format!(
-            "| {} | {:.6} | {:.3} | {:.3} | {:.3} | {:.6e} | {:.6e} | Ø{:.1} / Ø{:.1} | {} |\n",
+            "| {} | {:.6} | {:.3} | {} | {} | {} | {} | {} | {} |\n",
             d.design,
             d.mass_kg,
             d.volume_m3 * 1e6,
-            d.l1_m * 1e3,
-            d.offset_m * 1e3,
-            d.i_zz_kgm2,
-            d.i_xx_kgm2,
-            2e3 * d.crank_bore_radius_m,
-            2e3 * d.piston_bore_radius_m,
+            num(d.l1_m, &|v| format!("{:.3}", v * 1e3)),
+            num(d.offset_m, &|v| format!("{:.3}", v * 1e3)),
+            num(d.i_zz_kgm2, &|v| format!("{v:.6e}")),
+            num(d.i_xx_kgm2, &|v| format!("{v:.6e}")),
+            num(
+                d.crank_bore_radius_m + d.piston_bore_radius_m,
+                &|_| format!(
+                    "Ø{:.1} / Ø{:.1}",
+                    2e3 * d.crank_bore_radius_m,
+                    2e3 * d.piston_bore_radius_m
+                )
+            ),
             d.triangles
         ));
     }
