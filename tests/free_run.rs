@@ -15,16 +15,6 @@ fn opts(scene: FreeScene, atol: f64) -> FreeRunOptions {
     }
 }
 
-/// Max |Δφ| over the grid points where |cos φ| < 0.2 (around 90° and 270°).
-fn max_err_near_90(reference: &[f64], phi: &[f64]) -> f64 {
-    reference
-        .iter()
-        .zip(phi)
-        .filter(|(r, _)| r.cos().abs() < 0.2)
-        .map(|(r, p)| (r - p).abs())
-        .fold(0.0, f64::max)
-}
-
 #[test]
 fn reference_agrees_with_tight_rk45() {
     let scene = FreeScene::thesis();
@@ -48,20 +38,13 @@ fn reference_is_self_consistent() {
     let model = scene.model().unwrap();
     let grid = scene.grid().unwrap();
     let r = scene.reference().unwrap();
-    // 1. energy integral: E(φ_k, φ̇_k) = E0 to roundoff (E itself is ~20 J)
-    let e0 = model.energy(&scene.loads, 0.0, 0.0);
-    let residual = r
-        .phi
-        .iter()
-        .zip(&r.omega)
-        .map(|(&p, &w)| (model.energy(&scene.loads, p, w) - e0).abs())
-        .fold(0.0, f64::max);
-    assert!(residual < 1e-13, "energy residual {residual:e} J");
-    // 2. quadrature converged: a 100× tighter panel threshold changes nothing
+    // (the energy E(φ_k, φ̇_k) is not checked here: φ̇ is built from the energy integral, so it
+    // would hold by construction)
+    // 1. quadrature converged: a 100× tighter panel threshold changes nothing
     let tight = exact_reference_with_tol(&model, &scene.loads, 0.0, 0.0, &grid, 1e-13).unwrap();
     let (dp, dw) = r.max_errors(&tight.phi, &tight.omega);
     assert!(dp < 5e-14 && dw < 1e-12, "{dp:e} {dw:e}");
-    // 3. φ̇ from the energy integral = dφ/dt of the inverted t(φ) (6th-order differences)
+    // 2. φ̇ from the energy integral = dφ/dt of the inverted t(φ) (6th-order differences)
     let h = scene.dt_out;
     let c = [1.0 / 60.0, -3.0 / 20.0, 3.0 / 4.0];
     let mut worst: f64 = 0.0;
@@ -131,11 +114,12 @@ fn work_precision_sweep_meets_targets() {
             "initial-acceleration error ratio per decade {ratio}"
         );
     }
-    // rk45's error tracks its absolute tolerance (local extrapolation): within 0.1–20× tol
+    // rk45's error tracks its absolute tolerance (local extrapolation): measured 0.37–12.3× tol
+    // over atol 1e-4 … 1e-12 (reports/work_precision.md)
     for r in wp.rows_of(Method::Rk45) {
         let q = r.max_err_phi_rad.unwrap() / r.value;
         assert!(
-            (0.1..20.0).contains(&q),
+            (0.3..15.0).contains(&q),
             "rk45 at {:e}: error/tol = {q}",
             r.value
         );
@@ -155,7 +139,19 @@ fn run_free_result_and_names() {
     assert_eq!(r.t[0], 0.0);
     assert_eq!(*r.t.last().unwrap(), 1.0);
     assert!((r.t[5000] - 0.5).abs() < 1e-15);
-    assert!((r.phi_rad - 21.2676474).abs() < 1e-5 && (r.omega_rad_s - 42.76745).abs() < 1e-3);
+    // φ(1 s), φ̇(1 s) against the energy-integral reference (independent of any integrator), to
+    // BDF's default tolerance (atol 1e-8 on φ)
+    let reference = FreeScene::thesis().reference().unwrap();
+    let (phi_ref, omega_ref) = (
+        *reference.phi.last().unwrap(),
+        *reference.omega.last().unwrap(),
+    );
+    assert!(
+        (r.phi_rad - phi_ref).abs() < 1e-6 && (r.omega_rad_s - omega_ref).abs() < 1e-4,
+        "{} vs {phi_ref}, {} vs {omega_ref}",
+        r.phi_rad,
+        r.omega_rad_s
+    );
     assert!(r.steps > 0 && r.rhs_evals > r.steps && r.jac_evals >= 1 && r.cpu_s > 0.0);
     assert!(r.warnings.is_empty() && r.energy_drift_rel.unwrap() < 1e-6);
     let json = serde_json::to_value(&r).unwrap();
@@ -221,8 +217,6 @@ fn near_toggle_keeps_error_estimates_honest() {
             let rn = run_free(m, &opts(nominal, tol)).unwrap();
             let (et, _) = ref_t.max_errors(&rt.phi, &rt.omega);
             let (en, _) = ref_n.max_errors(&rn.phi, &rn.omega);
-            let e90 = max_err_near_90(&ref_t.phi, &rt.phi);
-            assert!(e90 <= et, "{m}");
             match m {
                 // local extrapolation / BDF: error a small multiple of the tolerance
                 Method::Rk45 | Method::Rk23 | Method::Bdf => {
@@ -410,9 +404,9 @@ fn stiff_gas_spring_explicit_methods_stop_implicit_finish() {
         fixed_step: 1e-4,
         ..opts(scene, 1e-8)
     };
-    let start = std::time::Instant::now();
+    // the explicit methods crawl and are stopped by the step cap (time is not asserted here:
+    // `rodstudy integrators` and the benchmarks measure it)
     let out = run_all(&Method::REDUCED, &o).unwrap();
-    assert!(start.elapsed().as_secs_f64() < 1.0);
     // static equilibrium: M + (F − k (x − x0)) p42 = 0 with p42(90°) = r
     let r = scene.data.r;
     let dphi_eq = (scene.loads.torque / r + scene.loads.piston_force) / (1e8 * r);

@@ -293,8 +293,9 @@ fn work_precision_sweep_includes_the_dae_forms() {
     assert!(rows.iter().all(|r| r.setting == "atol"));
     for r in &rows {
         let q = r.max_err_phi_rad.unwrap() / r.value;
+        // measured 1.9–17.6× tol over atol 1e-4 … 1e-12 (reports/work_precision.md)
         assert!(
-            (0.1..20.0).contains(&q),
+            (1.5..20.0).contains(&q),
             "dae-index1 at {:e}: error/tol {q}",
             r.value
         );
