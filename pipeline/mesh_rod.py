@@ -173,7 +173,11 @@ def gmsh_volume_mesh(stl: pathlib.Path, size_mm: float, curved: bool, angle_deg:
             # boundaries, make each patch parametrisable so that it can be remeshed at the target size.
             gmsh.model.mesh.classifySurfaces(math.radians(angle_deg), True, True, math.radians(curve_angle_deg))
             if geometry_out is not None:
+                # written and read back, so that a first mesh and a later one from the cached
+                # classification start from the same data (same mesh, bit for bit)
                 gmsh.write(str(geometry_out))
+                gmsh.clear()
+                gmsh.merge(str(geometry_out))
         gmsh.model.mesh.createGeometry()
         surfaces = [tag for _, tag in gmsh.model.getEntities(2)]
         loop = gmsh.model.geo.addSurfaceLoop(surfaces)

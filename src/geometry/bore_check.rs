@@ -181,7 +181,9 @@ mod tests {
         let tube = hollow_cylinder(30.0, 12.5, 40.0, 96);
         let s = RodSurface::new(&tube).unwrap();
         let z = Vector3::z();
-        let r = s.bore_radius("pin", Vector3::zeros(), z, 1.0, "mm").unwrap();
+        let r = s
+            .bore_radius("pin", Vector3::zeros(), z, 1.0, "mm")
+            .unwrap();
         let inscribed = 12.5 * (std::f64::consts::PI / 96.0).cos();
         assert!(r >= inscribed - 1e-9 && r <= 12.5 + 1e-9, "{r}");
         // y = 0 runs along edges of the annulus caps' triangulation

@@ -221,11 +221,45 @@ fn study_one(
     (computed, false)
 }
 
+/// The keys of the stage-3 record that hold wall times or memory: they vary from run to run.
+const WALL_TIME_KEYS: [&str; 4] = ["seconds", "total_s", "timings", "peak_memory_mb"];
+
+/// Removes the wall-time keys from a JSON value, at every depth.
+fn strip_wall_times(v: &mut serde_json::Value) {
+    match v {
+        serde_json::Value::Object(map) => {
+            for k in WALL_TIME_KEYS {
+                map.remove(k);
+            }
+            for x in map.values_mut() {
+                strip_wall_times(x);
+            }
+        }
+        serde_json::Value::Array(a) => a.iter_mut().for_each(strip_wall_times),
+        _ => {}
+    }
+}
+
 /// Writes `results.json`, `mass_properties.md` and `mass_properties.csv` into `out`
 /// (each atomically) and returns their paths.
 pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>> {
+    // results.json holds only what the computation decides (it is committed and must not change
+    // from run to run); the same record with the wall times goes to timings.json (not committed)
+    let full = serde_json::to_value(results)?;
+    write_atomic(
+        &out.join("timings.json"),
+        serde_json::to_string_pretty(&full)?.as_bytes(),
+    )?;
+    let mut stable = full;
+    if let Some(designs) = stable.get_mut("designs").and_then(|d| d.as_array_mut()) {
+        for d in designs {
+            if let Some(fem) = d.get_mut("fem") {
+                strip_wall_times(fem);
+            }
+        }
+    }
     let json = out.join("results.json");
-    write_atomic(&json, serde_json::to_string_pretty(results)?.as_bytes())?;
+    write_atomic(&json, serde_json::to_string_pretty(&stable)?.as_bytes())?;
     let md = out.join("mass_properties.md");
     write_atomic(&md, markdown(results).as_bytes())?;
     let csv_path = out.join("mass_properties.csv");
