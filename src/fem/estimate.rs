@@ -113,8 +113,7 @@ pub fn estimate_error(
                 .map(|a| von_mises(&rec.nodal[el[a]]))
                 .fold(0.0, f64::max);
             let x = mesh.element_coords(e);
-            let ue: [[f64; 3]; 10] =
-                std::array::from_fn(|a| std::array::from_fn(|j| u[3 * el[a] + j]));
+            let ue = mesh.element_displacements(e, u);
             let (mut err2, mut norm2) = (0.0, 0.0);
             for (p, w) in TET14.points.iter().zip(TET14.weights) {
                 let (g, det) = shape_gradients(&x, *p, e, "quadrature point")?;

@@ -80,9 +80,7 @@ fn gauss_samples(mesh: &TetMesh, material: &Material, u: &[f64]) -> Result<Sampl
         .into_par_iter()
         .map(|e| {
             let x: ElementCoords = mesh.element_coords(e);
-            let el = &mesh.elements()[e];
-            let ue: [[f64; 3]; 10] =
-                std::array::from_fn(|a| std::array::from_fn(|j| u[3 * el[a] + j]));
+            let ue = mesh.element_displacements(e, u);
             let mut pts = [[0.0; 3]; 4];
             let mut sig = [[0.0; 6]; 4];
             for (g, xi) in TET4.points.iter().enumerate() {

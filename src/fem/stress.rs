@@ -29,9 +29,7 @@ pub fn stress_field(mesh: &TetMesh, material: &Material, u: &[f64]) -> Result<St
         .into_par_iter()
         .map(|e| {
             let x: ElementCoords = mesh.element_coords(e);
-            let el = &mesh.elements()[e];
-            let ue: [[f64; 3]; 10] =
-                std::array::from_fn(|a| std::array::from_fn(|j| u[3 * el[a] + j]));
+            let ue = mesh.element_displacements(e, u);
             let mut out = [[0.0; 6]; 10];
             for (a, xi) in TET10_NODE_XI.iter().enumerate() {
                 let (g, _) = shape_gradients(&x, *xi, e, "node")?;

@@ -99,6 +99,12 @@ impl TetMesh {
         std::array::from_fn(|a| self.nodes[el[a]])
     }
 
+    /// The displacements of the ten nodes of element `e`, from `u` (3 per node).
+    pub fn element_displacements(&self, e: usize, u: &[f64]) -> [[f64; 3]; 10] {
+        let el = &self.elements[e];
+        std::array::from_fn(|a| std::array::from_fn(|j| u[3 * el[a] + j]))
+    }
+
     /// Mean length of the corner-to-corner edges over all elements (each edge counted per element), m:
     /// the characteristic element size.
     pub fn mean_edge_length(&self) -> f64 {
