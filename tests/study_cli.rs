@@ -245,3 +245,96 @@ fn configuration_file_sets_the_scene_and_typos_are_refused() {
         "{e}"
     );
 }
+
+/// A design whose FEM stage fails (here: `RODSTUDY_PYTHON` names a program that is not Python, so
+/// no mesh can be made) keeps its mass and peak force in every report, is not ranked on stress,
+/// and `check` still fails on it.
+#[test]
+fn a_later_stage_failure_keeps_the_earlier_figures() {
+    let designs = tempfile::tempdir().unwrap();
+    let out = tempfile::tempdir().unwrap();
+    rod_file(designs.path(), "good.stl");
+    let o = Command::new(env!("CARGO_BIN_EXE_rodstudy"))
+        .args(["study", "--no-cache", "--designs"])
+        .arg(designs.path())
+        .arg("--out")
+        .arg(out.path())
+        .env("RODSTUDY_PYTHON", "/bin/false")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    let results: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.path().join("results.json")).unwrap()).unwrap();
+    assert_eq!(results["designs"].as_array().unwrap().len(), 0);
+    let f = &results["failed"][0];
+    assert_eq!(f["stage"], "fem", "{f}");
+    let mass = f["mass"]["mass_kg"].as_f64().unwrap();
+    let force = f["dynamics"]["peak_pin_force_n"].as_f64().unwrap();
+    // the same figures as a study without stage 3
+    let skip = tempfile::tempdir().unwrap();
+    let o2 = rodstudy(&[
+        "study",
+        "--skip-fem",
+        "--no-cache",
+        "--designs",
+        designs.path().to_str().unwrap(),
+        "--out",
+        skip.path().to_str().unwrap(),
+    ]);
+    assert_eq!(o2.status.code(), Some(0));
+    let full: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(skip.path().join("results.json")).unwrap()).unwrap();
+    assert_eq!(full["designs"][0]["mass"]["mass_kg"].as_f64(), Some(mass));
+    assert_eq!(
+        full["designs"][0]["dynamics"]["peak_pin_force_n"].as_f64(),
+        Some(force)
+    );
+    // every report keeps them, with the failing stage, and ranks nothing
+    let mut csv = csv::Reader::from_path(out.path().join("ranking.csv")).unwrap();
+    let rows: Vec<csv::StringRecord> = csv.records().map(|r| r.unwrap()).collect();
+    let headers = csv.headers().unwrap().clone();
+    let col = |name: &str| headers.iter().position(|h| h == name).unwrap();
+    assert_eq!(rows.len(), 1);
+    assert_eq!(&rows[0][col("rank")], "", "not ranked");
+    assert_eq!(&rows[0][col("status")], "not judged (fem failed)");
+    assert_eq!(
+        rows[0][col("peak_pin_force_n")].parse::<f64>().unwrap(),
+        force
+    );
+    assert_eq!(&rows[0][col("safety_factor")], "");
+    let md = std::fs::read_to_string(out.path().join("ranking.md")).unwrap();
+    assert!(md.contains(&format!("{force:.1}")), "{md}");
+    assert!(md.contains("(fem stage)"), "{md}");
+    let html = std::fs::read_to_string(out.path().join("index.html")).unwrap();
+    assert!(
+        html.contains("<tr data-id=\"good\" class=\"failed\">"),
+        "{html}"
+    );
+    assert!(html.contains("The fem stage failed"), "{html}");
+    let masses = std::fs::read_to_string(out.path().join("mass_properties.csv")).unwrap();
+    assert!(masses.contains(",failed,fem,"), "{masses}");
+    assert!(out.path().join("good").join("pin_force.csv").is_file());
+    // the regression gate still fails on it
+    let base = out.path().join("baseline.json");
+    std::fs::write(
+        &base,
+        format!(
+            r#"{{"program_version":"x","designs":{{"good":{{"design":"good","peak_pin_force_n":{force},"mass_kg":{mass}}}}}}}"#
+        ),
+    )
+    .unwrap();
+    let c = rodstudy(&[
+        "check",
+        "--baseline",
+        base.to_str().unwrap(),
+        "--results",
+        out.path().join("results.json").to_str().unwrap(),
+    ]);
+    assert_ne!(c.status.code(), Some(0));
+    assert!(
+        String::from_utf8_lossy(&c.stdout).contains("failed:"),
+        "{}",
+        String::from_utf8_lossy(&c.stdout)
+    );
+}

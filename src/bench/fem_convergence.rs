@@ -191,11 +191,30 @@ pub fn convergence(
         rows,
         skipped,
     };
+    write_files(&result, out)?;
+    Ok(result)
+}
+
+/// Re-writes the table and the plot in `out` from the `convergence.json` a run left there (no
+/// analysis is repeated).
+pub fn replot(out: &Path) -> Result<Convergence> {
+    let path = out.join("convergence.json");
+    let text = std::fs::read_to_string(&path)
+        .with_context(|| format!("cannot read {}", path.display()))?;
+    let result: Convergence = serde_json::from_str(&text)
+        .with_context(|| format!("{}: not a convergence record", path.display()))?;
+    write_files(&result, out)?;
+    Ok(result)
+}
+
+/// Writes convergence.json, .md, .csv and .svg of `result` into `out`.
+fn write_files(result: &Convergence, out: &Path) -> Result<()> {
+    let design = Path::new(&result.design);
     write_atomic(
         &out.join("convergence.json"),
-        serde_json::to_string_pretty(&result)?.as_bytes(),
+        serde_json::to_string_pretty(result)?.as_bytes(),
     )?;
-    write_atomic(&out.join("convergence.md"), markdown(&result).as_bytes())?;
+    write_atomic(&out.join("convergence.md"), markdown(result).as_bytes())?;
     let mut w = csv::Writer::from_writer(Vec::new());
     for r in &result.rows {
         w.serialize(r)?;
@@ -230,7 +249,7 @@ pub fn convergence(
         Scale::Log,
     )?;
     write_atomic(&out.join("convergence.svg"), svg.as_bytes())?;
-    Ok(result)
+    Ok(())
 }
 
 /// The table as Markdown.

@@ -48,6 +48,10 @@ pub struct FemArgs {
     /// own process; writes convergence.md/.csv/.json/.svg into `--out`.
     #[arg(long, conflicts_with_all = ["refine", "mesh", "size"])]
     convergence: bool,
+    /// With `--convergence`: re-write the table and the plot from the convergence.json in
+    /// `--out`, without running the analyses again.
+    #[arg(long, requires = "convergence")]
+    replot: bool,
     /// Uniform sizes of `--convergence` [mm].
     #[arg(long, value_delimiter = ',', default_value = "8,5,3.5,2.5")]
     sizes: Vec<f64>,
@@ -94,18 +98,22 @@ pub fn run(args: FemArgs) -> Result<i32> {
         return refine(&args, &config, force, sizes);
     }
     if args.convergence {
-        let c = crate::bench::fem_convergence::convergence(
-            &args.design,
-            &args.sizes,
-            if config.fem.adaptive() {
-                config.fem.target_error
-            } else {
-                0.03
-            },
-            force,
-            args.config.as_deref(),
-            &args.out,
-        )?;
+        let c = if args.replot {
+            crate::bench::fem_convergence::replot(&args.out)?
+        } else {
+            crate::bench::fem_convergence::convergence(
+                &args.design,
+                &args.sizes,
+                if config.fem.adaptive() {
+                    config.fem.target_error
+                } else {
+                    0.03
+                },
+                force,
+                args.config.as_deref(),
+                &args.out,
+            )?
+        };
         if args.json {
             println!("{}", serde_json::to_string_pretty(&c)?);
         } else {

@@ -359,6 +359,13 @@ pub fn adaptive_rod(
         }
         if let Some(stop) = stop {
             let mut solution = sol;
+            for (c, case) in [&mut solution.result.fx, &mut solution.result.fy]
+                .into_iter()
+                .enumerate()
+            {
+                case.estimated_error_rel = estimates[c];
+                case.adaptive = steps[c].clone();
+            }
             if let Some(dir) = &rod.vtu_dir {
                 write_rod_vtus(
                     &mut solution,
@@ -366,13 +373,6 @@ pub fn adaptive_rod(
                     dir,
                     rod.vtu_stem.as_deref().unwrap_or("rod"),
                 )?;
-            }
-            for (c, case) in [&mut solution.result.fx, &mut solution.result.fy]
-                .into_iter()
-                .enumerate()
-            {
-                case.estimated_error_rel = estimates[c];
-                case.adaptive = steps[c].clone();
             }
             solution.result.total_s = t_all.elapsed().as_secs_f64();
             return Ok(AdaptiveSolution {

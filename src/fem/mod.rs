@@ -23,6 +23,7 @@
 pub mod adapt;
 pub mod assembly;
 pub mod bench;
+pub mod body_force;
 pub mod bores;
 pub mod boundary;
 pub mod element;
@@ -32,6 +33,7 @@ pub mod facets;
 pub mod load;
 pub mod material;
 pub mod mesh;
+pub mod picture;
 pub mod quadrature;
 pub mod recovery;
 pub mod rod;

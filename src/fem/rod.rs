@@ -107,6 +107,9 @@ pub struct LoadCaseResult {
     pub adaptive: Vec<AdaptiveStep>,
     /// ParaView file, if written.
     pub vtu: Option<PathBuf>,
+    /// Picture of the von Mises field on the surface (SVG), if written.
+    #[serde(default)]
+    pub picture: Option<PathBuf>,
 }
 
 /// One iteration of the adaptive loop, for one load case.
@@ -368,6 +371,7 @@ pub fn solve_rod_fields(
             error_estimate: estimate.summary,
             adaptive: Vec::new(),
             vtu: None,
+            picture: None,
         });
         fields.push(field);
         estimates.push(estimate);
@@ -428,8 +432,9 @@ pub fn solve_rod_fields(
     Ok(solution)
 }
 
-/// Writes the ParaView files `<dir>/<stem>_fx.vtu` and `_fy.vtu` of a solution on `mesh` and
-/// records their paths in its figures.
+/// Writes the ParaView files `<dir>/<stem>_fx.vtu` and `_fy.vtu` of a solution on `mesh`, and the
+/// pictures of the von Mises field `<dir>/von_mises_fx.svg` and `_fy.svg`, and records their paths
+/// in its figures.
 pub fn write_rod_vtus(
     solution: &mut RodSolution,
     mesh: &TetMesh,
@@ -455,7 +460,56 @@ pub fn write_rod_vtus(
             &solution.away_from_fixed,
         )?;
         case.vtu = Some(path);
+        let picture = dir.join(format!("von_mises_{}.svg", case.name));
+        write_case_picture(&picture, mesh, &solution.stresses[c], case)?;
+        case.picture = Some(picture);
     }
+    Ok(())
+}
+
+/// The picture of one case: the nodally averaged von Mises stress on the surface, the colour
+/// scale up to the judged peak (away from the fixed bore and the singular edges; the singular
+/// peaks above it get the scale's "over" colour) and that peak marked.
+fn write_case_picture(
+    path: &std::path::Path,
+    mesh: &TetMesh,
+    field: &StressField,
+    case: &LoadCaseResult,
+) -> Result<()> {
+    use super::picture::{PictureOptions, SurfaceField, render_svg, tet10_surface};
+    let (vertices_mm, triangles) = tet10_surface(mesh)?;
+    let values: Vec<f64> = field
+        .von_mises_averaged()
+        .iter()
+        .map(|v| v * 1e-6)
+        .collect();
+    let peak = case.max_von_mises_away_from_fixed_mpa;
+    let label = if case.name == "fx" { "F_x" } else { "F_y" };
+    let svg = render_svg(
+        &SurfaceField {
+            vertices_mm: &vertices_mm,
+            triangles: &triangles,
+            values: &values,
+        },
+        &PictureOptions {
+            title: format!(
+                "von Mises stress [MPa], {label} case: {:.0} N on the crank-pin bore, small-end bore fixed",
+                case.force_n
+            ),
+            unit: "MPa".into(),
+            range: [0.0, if peak > 0.0 { peak } else { 1.0 }],
+            marker_mm: Some(case.max_von_mises_away_from_fixed_at_mm),
+            marker_label: format!(
+                "peak {peak:.1} MPa ± {:.1} %",
+                100.0 * case.estimated_error_rel
+            ),
+            width_px: 960,
+        },
+    )
+    .map_err(|e| FemError::Check(format!("{}: picture: {e:#}", path.display())))?;
+    let tmp = path.with_extension("svg.tmp");
+    std::fs::write(&tmp, svg).map_err(|e| FemError::io(&tmp, e))?;
+    std::fs::rename(&tmp, path).map_err(|e| FemError::io(path, e))?;
     Ok(())
 }
 

@@ -25,6 +25,7 @@
 //! | `forward.rs` | forward dynamics of such systems: the index-1 form [M −Dᵀ; D 0][c̈; λ] = [h; γ̃] (plain or Baumgarte), constraint violation, projection onto Φ = 0, D ċ = ν |
 //! | `crank_slider.rs` | [`RodInertia`], [`MechanismParams`] (spec defaults, builder, validation), [`CrankSlider`] (validated model, its multibody form), [`PinLoads`] |
 //! | `closed_form.rs` | closed-form kinematics (eq. 2.1–2.12) and hand-solved Newton–Euler loads: the oracle |
+//! | `rod_cycle.rs` | [`rod_frame_cycle`]: one revolution in the rod frame (a_A, ω₃, α₃, g, pin forces from the rod's Newton–Euler) for the FEM stage |
 //! | `peak.rs` | the true maximum of \|F_A\| (scan + golden section on the closed form) |
 //! | `scene.rs` | scene `driven`: [`DrivenScene`], [`Method`], [`driven_scene`], [`DrivenResult`], [`compare_results`] |
 //! | `study.rs` | Table 5.1, the TDC formula, the l₁ that reproduces a peak, peak sensitivities |
@@ -62,6 +63,7 @@ pub mod lu;
 pub mod motion;
 pub mod peak;
 pub mod revolute;
+pub mod rod_cycle;
 pub mod scene;
 pub mod study;
 pub mod system;
@@ -77,6 +79,7 @@ pub use error::{DynamicsError, Result};
 pub use forward::{Baumgarte, ConstraintViolation, ForwardSolution};
 pub use motion::{CrankMotion, MotionSample};
 pub use peak::{PeakRefinement, refine_peak, wrap_degrees};
+pub use rod_cycle::{RodFrameInstant, acceleration_of, rod_frame_cycle};
 pub use scene::{Agreement, DrivenResult, DrivenScene, Method, compare_results, driven_scene};
 pub use study::{
     L1Fit, PeakSensitivity, TABLE_5_1, Table51Check, Table51Row, l1_for_peak_force, peak_pin_force,

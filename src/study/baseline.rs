@@ -270,6 +270,7 @@ mod tests {
         none.failed.push(FailedDesign {
             file: "designs/rod.stl".into(),
             error: "open mesh".into(),
+            ..FailedDesign::default()
         });
         let rows = check(&base, &none, 0.005, 0.001);
         assert_eq!(rows.len(), 1);

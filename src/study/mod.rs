@@ -10,6 +10,7 @@ pub mod cache;
 pub mod config;
 pub mod dynamics_stage;
 pub mod fem_stage;
+pub mod index_page;
 pub mod plots;
 pub mod ranking;
 pub mod tables;
@@ -54,11 +55,40 @@ pub struct DesignResult {
     pub history: DrivenResult,
 }
 
-/// A design that could not be studied, and why.
-#[derive(Debug, Clone, Serialize, serde::Deserialize)]
+/// A design that could not be studied through every stage: the stage that failed, why, and
+/// what the stages before it computed (kept in every report; such a design is not judged on the
+/// criterion of the stage it did not pass).
+#[derive(Debug, Clone, Default, Serialize, serde::Deserialize)]
 pub struct FailedDesign {
     pub file: String,
     pub error: String,
+    /// The stage that failed: one of [`STAGES`] (empty in files written before 0.3).
+    #[serde(default)]
+    pub stage: String,
+    /// Stage 1's figures, when it passed.
+    #[serde(default)]
+    pub mass: Option<DesignMass>,
+    /// Stage 2's figures, when it passed.
+    #[serde(default)]
+    pub dynamics: Option<DesignDynamics>,
+    /// Stage 2's pin-force history (written to its own CSV, not to `results.json`).
+    #[serde(skip)]
+    pub history: Option<DrivenResult>,
+}
+
+impl FailedDesign {
+    /// The design's id: its file stem (as [`DesignMass::id`]).
+    pub fn id(&self) -> String {
+        self.mass.as_ref().map_or_else(
+            || {
+                Path::new(&self.file)
+                    .file_stem()
+                    .map(|s| s.to_string_lossy().into_owned())
+                    .unwrap_or_else(|| self.file.clone())
+            },
+            |m| m.id.clone(),
+        )
+    }
 }
 
 /// How a study runs: where, with which settings, how many designs at once.
@@ -105,7 +135,7 @@ pub fn run_study(
         .num_threads(options.jobs)
         .build()
         .context("cannot start the worker threads")?;
-    let outcomes: Vec<(PathBuf, Result<DesignResult>)> = pool.install(|| {
+    let outcomes: Vec<std::result::Result<DesignResult, Box<FailedDesign>>> = pool.install(|| {
         files
             .into_par_iter()
             .map(|f| {
@@ -113,9 +143,9 @@ pub fn run_study(
                 on_done(Progress {
                     file: &f,
                     cached,
-                    outcome: r.as_ref().map_err(|e| format!("{e:#}")),
+                    outcome: r.as_ref().map_err(|e| e.error.clone()),
                 });
-                (f, r)
+                r
             })
             .collect()
     });
@@ -135,25 +165,22 @@ pub fn run_study(
         designs: Vec::new(),
         failed: Vec::new(),
     };
-    for (file, outcome) in outcomes {
+    for outcome in outcomes {
         match outcome {
             Ok(d) => results.designs.push(d),
-            Err(e) => results.failed.push(FailedDesign {
-                file: file.display().to_string(),
-                error: format!("{e:#}"),
-            }),
+            Err(f) => results.failed.push(*f),
         }
     }
     Ok(results)
 }
 
 /// The stages for one design, from the cache when its content hash matches; the flag says
-/// whether the cache answered.
+/// whether the cache answered. A failure keeps what the stages before it computed.
 fn study_one(
     stl: &Path,
     options: &StudyOptions,
     cache: Option<&Cache>,
-) -> (Result<DesignResult>, bool) {
+) -> (std::result::Result<DesignResult, Box<FailedDesign>>, bool) {
     let config = &options.config;
     let id = stl
         .file_stem()
@@ -167,8 +194,22 @@ fn study_one(
         }
     });
     let scene = config.driven_scene();
+    // the per-design files stage 3 writes beside its figures: a cached entry without them is
+    // recomputed
+    let files_present = |fem: &Option<DesignFem>| {
+        fem.is_none()
+            || [
+                "von_mises_fx.svg",
+                "von_mises_fy.svg",
+                "fem_fx.vtu",
+                "fem_fy.vtu",
+            ]
+            .iter()
+            .all(|f| options.out.join(file_safe(&id)).join(f).is_file())
+    };
     if let (Some(cache), Some(key)) = (cache, &key)
         && let Some(hit) = cache.get::<CachedDesign>(&id, key)
+        && files_present(&hit.fem)
     {
         let params = dynamics_stage::mechanism_for(&hit.mass, config.driven.gravity);
         let rod = dynamics_stage::rod_inertia(&hit.mass);
@@ -184,10 +225,20 @@ fn study_one(
             return (Ok(result), true);
         }
     }
+    let mut failed = FailedDesign {
+        file: stl.display().to_string(),
+        ..FailedDesign::default()
+    };
     let computed = (|| {
+        failed.stage = STAGES[0].into();
         let mass = mass_of_design(stl)?;
+        failed.mass = Some(mass.clone());
+        failed.stage = STAGES[1].into();
         let (dynamics, history) =
             dynamics_of_design(&mass, &scene, config.driven.gravity, Method::ClosedForm)?;
+        failed.dynamics = Some(dynamics.clone());
+        failed.history = Some(history.clone());
+        failed.stage = STAGES[2].into();
         let fem = if options.skip_fem {
             None
         } else {
@@ -202,7 +253,7 @@ fn study_one(
                 &MeshMode::from_config(config),
             )?)
         };
-        Ok(DesignResult {
+        anyhow::Ok(DesignResult {
             mass,
             dynamics,
             fem,
@@ -218,7 +269,13 @@ fn study_one(
         // A cache that cannot be written only costs time on the next run.
         let _ = cache.put(&id, key, &entry);
     }
-    (computed, false)
+    let outcome = computed.map_err(|e| {
+        Box::new(FailedDesign {
+            error: format!("{e:#}"),
+            ..failed
+        })
+    });
+    (outcome, false)
 }
 
 /// The keys of the stage-3 record that hold wall times or memory: they vary from run to run.
@@ -269,14 +326,24 @@ pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>>
     let ranking_csv = out.join("ranking.csv");
     write_atomic(&ranking_csv, &ranking::csv(results)?)?;
     let mut written = vec![json, md, csv_path, ranking, ranking_csv];
-    if !results.designs.is_empty() {
+    let histories = histories(results);
+    for (id, design, h) in &histories {
+        let dir = out.join(file_safe(id));
+        let mut w = csv::Writer::from_writer(Vec::new());
+        write_history_csv(&mut w, design, h)?;
+        let path = dir.join("pin_force.csv");
+        write_atomic(&path, &w.into_inner()?)?;
+        let plot = dir.join("pin_force.svg");
+        write_atomic(&plot, design_pin_force_plot(design, h)?.as_bytes())?;
+        written.extend([path, plot]);
+    }
+    if !histories.is_empty() {
         let pin = out.join("pin_force.svg");
-        write_atomic(&pin, pin_force_plot(results)?.as_bytes())?;
+        write_atomic(&pin, pin_force_plot(&histories)?.as_bytes())?;
         let bars = out.join("peak_force.svg");
-        let peaks: Vec<(String, f64)> = results
-            .designs
+        let peaks: Vec<(String, f64)> = ranking::ranking(results)
             .iter()
-            .map(|d| (d.mass.id.clone(), d.dynamics.peak_pin_force_n))
+            .filter_map(|r| Some((r.mass.id.clone(), r.peak_force_n()?)))
             .collect();
         write_atomic(
             &bars,
@@ -287,36 +354,78 @@ pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>>
             )?
             .as_bytes(),
         )?;
-        let index = out.join("index.html");
-        write_atomic(&index, index_html(results).as_bytes())?;
-        written.extend([pin, bars, index]);
+        written.extend([pin, bars]);
     }
-    for d in &results.designs {
-        let mut w = csv::Writer::from_writer(Vec::new());
-        write_history_csv(&mut w, &d.mass.design, &d.history)?;
-        let path = out.join(file_safe(&d.mass.id)).join("pin_force.csv");
-        write_atomic(&path, &w.into_inner()?)?;
-        written.push(path);
-    }
+    let index = out.join("index.html");
+    write_atomic(&index, index_page::index_html(results, out).as_bytes())?;
+    written.push(index);
     Ok(written)
 }
 
-/// |F_A| over the first crank revolution, all designs in one plot.
-fn pin_force_plot(results: &StudyResults) -> Result<String> {
-    let series: Vec<plots::Series> = results
-        .designs
+/// (id, name, pin-force history) of every design that passed stage 2, in ranking order.
+fn histories(results: &StudyResults) -> Vec<(String, String, &DrivenResult)> {
+    ranking::ranking(results)
         .iter()
-        .map(|d| {
-            let h = &d.history;
-            let turn = std::f64::consts::TAU;
-            let points = (0..h.t_s.len())
-                .take_while(|&k| h.phi_rad[k] - h.phi_rad[0] <= turn + 1e-9)
-                .map(|k| ((h.phi_rad[k] - h.phi_rad[0]).to_degrees(), h.fa_abs_n[k]))
-                .collect();
-            plots::Series {
-                name: d.mass.design.clone(),
-                points,
-            }
+        .filter_map(|r| {
+            let h = results
+                .designs
+                .iter()
+                .find(|d| d.mass.id == r.mass.id)
+                .map(|d| &d.history)
+                .or_else(|| {
+                    results
+                        .failed
+                        .iter()
+                        .find(|f| f.mass.as_ref().is_some_and(|m| m.id == r.mass.id))
+                        .and_then(|f| f.history.as_ref())
+                })?;
+            Some((r.mass.id.clone(), r.mass.design.clone(), h))
+        })
+        .collect()
+}
+
+/// The points of one history over its first crank revolution: (φ − φ₀ [°], value).
+fn first_turn(h: &DrivenResult, value: impl Fn(usize) -> f64) -> Vec<(f64, f64)> {
+    let turn = std::f64::consts::TAU;
+    (0..h.t_s.len())
+        .take_while(|&k| h.phi_rad[k] - h.phi_rad[0] <= turn + 1e-9)
+        .map(|k| ((h.phi_rad[k] - h.phi_rad[0]).to_degrees(), value(k)))
+        .collect()
+}
+
+/// One design's pin force over the first revolution: |F_A| and its components.
+fn design_pin_force_plot(design: &str, h: &DrivenResult) -> Result<String> {
+    let series = vec![
+        plots::Series {
+            name: "|F_A|".into(),
+            points: first_turn(h, |k| h.fa_abs_n[k]),
+        },
+        plots::Series {
+            name: "F_Ax".into(),
+            points: first_turn(h, |k| h.fa_x_n[k]),
+        },
+        plots::Series {
+            name: "F_Ay".into(),
+            points: first_turn(h, |k| h.fa_y_n[k]),
+        },
+    ];
+    plots::line_chart(
+        &format!("{design}: crank–rod pin force (φ = 40πt, gravity on)"),
+        "crank angle φ [°] (0 = top dead centre)",
+        "force by the crank on the rod at A [N] (global frame)",
+        &series,
+        plots::Scale::Linear,
+        plots::Scale::Linear,
+    )
+}
+
+/// |F_A| over the first crank revolution, all designs in one plot.
+fn pin_force_plot(histories: &[(String, String, &DrivenResult)]) -> Result<String> {
+    let series: Vec<plots::Series> = histories
+        .iter()
+        .map(|(_, design, h)| plots::Series {
+            name: design.clone(),
+            points: first_turn(h, |k| h.fa_abs_n[k]),
         })
         .collect();
     plots::line_chart(
@@ -326,56 +435,6 @@ fn pin_force_plot(results: &StudyResults) -> Result<String> {
         &series,
         plots::Scale::Linear,
         plots::Scale::Linear,
-    )
-}
-
-/// A page that shows the ranking and the plots in a browser.
-fn index_html(results: &StudyResults) -> String {
-    let escape = |s: &str| {
-        s.replace('&', "&amp;")
-            .replace('<', "&lt;")
-            .replace('>', "&gt;")
-    };
-    let mut ranked: Vec<&DesignResult> = results.designs.iter().collect();
-    ranked.sort_by(|a, b| {
-        a.dynamics
-            .peak_pin_force_n
-            .total_cmp(&b.dynamics.peak_pin_force_n)
-    });
-    let mut rows = String::new();
-    for (k, d) in ranked.iter().enumerate() {
-        rows.push_str(&format!(
-            "<tr><td>{}</td><td>{}</td><td>{:.4}</td><td>{:.2}</td><td>{:.5}</td><td>{:.6}</td><td>{:.1}</td><td><a href=\"{}/pin_force.csv\">CSV</a></td></tr>\n",
-            k + 1,
-            escape(&d.mass.design),
-            d.mass.mass_kg,
-            d.mass.l1_m * 1e3,
-            d.mass.i_zz_kgm2,
-            d.mass.i_xx_kgm2,
-            d.dynamics.peak_pin_force_n,
-            file_safe(&d.mass.id)
-        ));
-    }
-    let failed: String = results
-        .failed
-        .iter()
-        .map(|f| {
-            format!(
-                "<li><code>{}</code>: {}</li>\n",
-                escape(&f.file),
-                escape(&f.error)
-            )
-        })
-        .collect();
-    format!(
-        "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>rodstudy report</title>\n<style>body{{font-family:sans-serif;max-width:1000px;margin:2em auto}}table{{border-collapse:collapse}}td,th{{border:1px solid #ccc;padding:4px 8px;text-align:right}}td:nth-child(2){{text-align:left}}img{{max-width:100%}}</style></head><body>\n<h1>Connecting-rod design study</h1>\n<p>Stages run: {}. Skipped: {}. Ranked by peak crank–rod pin force, lowest first.</p>\n<table><tr><th>rank</th><th>design</th><th>mass [kg]</th><th>l1 [mm]</th><th>I_zz [kg·m²]</th><th>I_xx [kg·m²]</th><th>peak pin force [N]</th><th>history</th></tr>\n{rows}</table>\n{}<h2>Pin force over one revolution</h2><img src=\"pin_force.svg\" alt=\"pin force\">\n<h2>Peak pin force</h2><img src=\"peak_force.svg\" alt=\"peak force\">\n<p>All figures: <a href=\"results.json\">results.json</a>, <a href=\"mass_properties.csv\">mass_properties.csv</a>.</p>\n</body></html>\n",
-        results.stages_run.join(", "),
-        results.stages_skipped.join(", "),
-        if failed.is_empty() {
-            String::new()
-        } else {
-            format!("<h2>Failed designs</h2><ul>{failed}</ul>\n")
-        }
     )
 }
 
@@ -393,7 +452,13 @@ fn file_safe(name: &str) -> String {
 }
 
 fn markdown(results: &StudyResults) -> String {
-    let designs: Vec<&DesignMass> = results.designs.iter().map(|d| &d.mass).collect();
+    // every design that passed stage 1, those that failed later included
+    let designs: Vec<&DesignMass> = results
+        .designs
+        .iter()
+        .map(|d| &d.mass)
+        .chain(results.failed.iter().filter_map(|f| f.mass.as_ref()))
+        .collect();
     let mut out = format!(
         "# Mass properties of the designs\n\nStages run: {}. Skipped: {}.\nI_zz is about the pin axis through the centroid (the one the planar dynamics uses); I_xx is about the rod's long axis (what the thesis' Table 5.1 lists).\n\n",
         results.stages_run.join(", "),
@@ -403,7 +468,10 @@ fn markdown(results: &StudyResults) -> String {
     if !results.failed.is_empty() {
         out.push_str("\n## Failed designs\n\n");
         for f in &results.failed {
-            out.push_str(&format!("- `{}`: {}\n", f.file, f.error));
+            out.push_str(&format!(
+                "- `{}` ({} stage): {}\n",
+                f.file, f.stage, f.error
+            ));
         }
     }
     out
@@ -425,13 +493,24 @@ struct CsvRow {
     centroid_z_m: Option<f64>,
     peak_pin_force_n: Option<f64>,
     status: &'static str,
+    /// The stage that failed (empty when none did).
+    stage: String,
     error: String,
 }
 
 fn csv_table(results: &StudyResults) -> Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    for d in &results.designs {
-        let m = &d.mass;
+    let rows = results
+        .designs
+        .iter()
+        .map(|d| (&d.mass, Some(&d.dynamics), None))
+        .chain(
+            results
+                .failed
+                .iter()
+                .filter_map(|f| f.mass.as_ref().map(|m| (m, f.dynamics.as_ref(), Some(f)))),
+        );
+    for (m, dynamics, failed) in rows {
         w.serialize(CsvRow {
             design: m.design.clone(),
             file: m.file.clone(),
@@ -444,15 +523,17 @@ fn csv_table(results: &StudyResults) -> Result<Vec<u8>> {
             centroid_x_m: Some(m.centroid_m[0]),
             centroid_y_m: Some(m.centroid_m[1]),
             centroid_z_m: Some(m.centroid_m[2]),
-            peak_pin_force_n: Some(d.dynamics.peak_pin_force_n),
-            status: "ok",
-            error: String::new(),
+            peak_pin_force_n: dynamics.map(|d| d.peak_pin_force_n),
+            status: if failed.is_some() { "failed" } else { "ok" },
+            stage: failed.map(|f| f.stage.clone()).unwrap_or_default(),
+            error: failed.map(|f| f.error.clone()).unwrap_or_default(),
         })?;
     }
-    for f in &results.failed {
+    for f in results.failed.iter().filter(|f| f.mass.is_none()) {
         w.serialize(CsvRow {
             file: f.file.clone(),
             status: "failed",
+            stage: f.stage.clone(),
             error: f.error.clone(),
             ..CsvRow::default()
         })?;

@@ -44,21 +44,30 @@ fn range(series: &[Series], pick: impl Fn(&(f64, f64)) -> f64, scale: Scale) -> 
     }
 }
 
-/// Tick label: powers of ten as `1e-6` on log axes, plain short numbers on linear ones.
+/// Tick label: short plain numbers (`20`, `0.05`) between 1e-3 and 1e4, powers of ten as `1e-6`
+/// and other values as `2e-6` outside it.
 fn tick(v: f64, scale: Scale) -> String {
+    let plain = |v: f64| {
+        let s = format!("{v:.6}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    };
     match scale {
         Scale::Log => {
-            let e = v.log10().round();
-            if (v.log10() - e).abs() < 1e-6 {
-                format!("1e{e}")
+            let exp = v.log10().floor();
+            let mantissa = v / 10f64.powf(exp);
+            if (1e-3..1e4).contains(&v) {
+                plain(v)
+            } else if (mantissa - mantissa.round()).abs() < 1e-6 {
+                if mantissa.round() == 1.0 {
+                    format!("1e{exp}")
+                } else {
+                    format!("{:.0}e{exp}", mantissa.round())
+                }
             } else {
                 format!("{v:.1e}")
             }
         }
-        Scale::Linear => {
-            let s = format!("{v:.6}");
-            s.trim_end_matches('0').trim_end_matches('.').to_string()
-        }
+        Scale::Linear => plain(v),
     }
 }
 
@@ -78,14 +87,23 @@ pub fn line_chart(
     }
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, (960, 640)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
+        let whole = SVGBackend::with_string(&mut svg, (960, 640)).into_drawing_area();
+        whole.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
+        // the legend sits in its own column right of the plot, never on the data
+        let longest = series
+            .iter()
+            .map(|s| s.name.chars().count())
+            .max()
+            .unwrap_or(0);
+        let legend_px = (40 + 8 * longest as u32).clamp(110, 320);
+        let (root, legend) = whole.split_horizontally(960 - legend_px);
+        draw_legend(&legend, series)?;
         let builder = |root| {
             let mut b = ChartBuilder::on(root);
             b.caption(title, ("sans-serif", 22))
                 .margin(12)
-                .x_label_area_size(48)
-                .y_label_area_size(80);
+                .x_label_area_size(52)
+                .y_label_area_size(90);
             b
         };
         macro_rules! draw {
@@ -95,6 +113,9 @@ pub fn line_chart(
                     .configure_mesh()
                     .x_desc(x_label)
                     .y_desc(y_label)
+                    .axis_desc_style(("sans-serif", 16))
+                    .label_style(("sans-serif", 14))
+                    .light_line_style(RGBColor(235, 235, 235))
                     .x_label_formatter(&|v| tick(*v, x_scale))
                     .y_label_formatter(&|v| tick(*v, y_scale))
                     .draw()
@@ -113,24 +134,13 @@ pub fn line_chart(
                         .collect();
                     chart
                         .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))
-                        .map_err(|e| anyhow!("{e}"))?
-                        .label(s.name.as_str())
-                        .legend(move |(x, y)| {
-                            PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-                        });
+                        .map_err(|e| anyhow!("{e}"))?;
                     if points.len() <= 60 {
                         chart
                             .draw_series(points.iter().map(|&p| Circle::new(p, 3, colour.filled())))
                             .map_err(|e| anyhow!("{e}"))?;
                     }
                 }
-                chart
-                    .configure_series_labels()
-                    .background_style(WHITE.mix(0.85))
-                    .border_style(BLACK)
-                    .position(SeriesLabelPosition::UpperRight)
-                    .draw()
-                    .map_err(|e| anyhow!("{e}"))?;
             }};
         }
         match (x_scale, y_scale) {
@@ -147,9 +157,29 @@ pub fn line_chart(
                 draw!(builder(&root).build_cartesian_2d(x0..x1, y0..y1))
             }
         }
-        root.present().map_err(|e| anyhow!("{e}"))?;
+        whole.present().map_err(|e| anyhow!("{e}"))?;
     }
     Ok(svg)
+}
+
+/// The legend of a line chart, one entry per series, top-down in its own drawing area.
+fn draw_legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    series: &[Series],
+) -> Result<()> {
+    let font = ("sans-serif", 15).into_font();
+    for (k, s) in series.iter().enumerate() {
+        let colour = COLOURS[k % COLOURS.len()];
+        let y = 60 + 24 * k as i32;
+        area.draw(&PathElement::new(
+            vec![(4, y), (28, y)],
+            colour.stroke_width(3),
+        ))
+        .map_err(|e| anyhow!("{e:?}"))?;
+        area.draw(&Text::new(s.name.clone(), (34, y - 8), font.clone()))
+            .map_err(|e| anyhow!("{e:?}"))?;
+    }
+    Ok(())
 }
 
 /// A bar chart of one value per label, as SVG text.
@@ -165,13 +195,17 @@ pub fn bar_chart(title: &str, y_label: &str, bars: &[(String, f64)]) -> Result<S
             .margin(12)
             .x_label_area_size(48)
             .y_label_area_size(80)
-            .build_cartesian_2d((0..n).into_segmented(), 0.0..top)
+            // `a..b` segmented has the segments a..=b: one per bar is 0..n−1
+            .build_cartesian_2d((0..n.saturating_sub(1)).into_segmented(), 0.0..top)
             .map_err(|e| anyhow!("{e}"))?;
         let labels: Vec<String> = bars.iter().map(|b| b.0.clone()).collect();
         chart
             .configure_mesh()
             .disable_x_mesh()
             .y_desc(y_label)
+            .axis_desc_style(("sans-serif", 16))
+            .label_style(("sans-serif", 14))
+            .y_label_formatter(&|v| tick(*v, Scale::Linear))
             .x_labels(bars.len())
             .x_label_formatter(&|v| match v {
                 SegmentValue::CenterOf(i) => labels.get(*i as usize).cloned().unwrap_or_default(),
@@ -191,6 +225,21 @@ pub fn bar_chart(title: &str, y_label: &str, bars: &[(String, f64)]) -> Result<S
                 );
                 bar.set_margin(0, 0, 12, 12);
                 bar
+            }))
+            .map_err(|e| anyhow!("{e}"))?;
+        // the value over each bar
+        chart
+            .draw_series(bars.iter().enumerate().map(|(i, b)| {
+                Text::new(
+                    format!("{:.1}", b.1),
+                    (SegmentValue::CenterOf(i as u32), b.1 + 0.015 * top),
+                    TextStyle::from(("sans-serif", 14).into_font()).pos(
+                        plotters::style::text_anchor::Pos::new(
+                            plotters::style::text_anchor::HPos::Center,
+                            plotters::style::text_anchor::VPos::Bottom,
+                        ),
+                    ),
+                )
             }))
             .map_err(|e| anyhow!("{e}"))?;
         root.present().map_err(|e| anyhow!("{e}"))?;

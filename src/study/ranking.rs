@@ -1,36 +1,158 @@
-//! The ranking (SPEC "Outputs"): designs that meet the stress criterion first, then by peak pin
-//! force, lowest first. Without the FEM stage no design is judged on stress and the order is by
-//! force alone.
+//! The ranking (SPEC "Outputs"): one structure, three renderings (`ranking.md`, `ranking.csv`, the
+//! table of `index.html`), so every report gives the same order and the same columns.
+//!
+//! Order: designs that meet the stress criterion first, then by peak pin force, lowest first.
+//! Without the FEM stage no design is judged on stress and the order is by force alone. A design
+//! whose FEM stage failed keeps its mass and peak force but is not ranked: it follows the ranked
+//! designs, without a rank, with the failing stage and its message as its status.
 
-use super::{DesignResult, StudyResults};
+use super::fem_stage::DesignFem;
+use super::{DesignResult, FailedDesign, StudyResults};
+use crate::geometry::design::DesignMass;
+use crate::study::dynamics_stage::DesignDynamics;
 use anyhow::Result;
 use serde::Serialize;
 
-/// The designs in ranking order.
-pub fn ranked(results: &StudyResults) -> Vec<&DesignResult> {
-    let mut order: Vec<&DesignResult> = results.designs.iter().collect();
+/// The verdict of one row.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Status {
+    /// Meets the stress criterion.
+    Pass,
+    /// Does not.
+    Fail,
+    /// Stage 3 was left out of the study on purpose.
+    NotJudged,
+    /// A stage failed; the earlier stages' figures are kept.
+    StageFailed { stage: String, error: String },
+}
+
+impl Status {
+    /// The short word of the status column.
+    pub fn word(&self) -> String {
+        match self {
+            Status::Pass => "pass".into(),
+            Status::Fail => "fail".into(),
+            Status::NotJudged => "not judged (FEM skipped)".into(),
+            Status::StageFailed { stage, .. } => format!("not judged ({stage} failed)"),
+        }
+    }
+    /// A CSS class for the html rendering.
+    fn class(&self) -> &'static str {
+        match self {
+            Status::Pass => "pass",
+            Status::Fail => "fail",
+            Status::NotJudged => "unjudged",
+            Status::StageFailed { .. } => "failed",
+        }
+    }
+}
+
+/// One design in the ranking, whatever stages it passed.
+#[derive(Clone, Debug)]
+pub struct RankRow<'a> {
+    /// 1-based; `None` for a design that could not be judged because a stage failed.
+    pub rank: Option<usize>,
+    pub mass: &'a DesignMass,
+    pub dynamics: Option<&'a DesignDynamics>,
+    pub fem: Option<&'a DesignFem>,
+    pub status: Status,
+}
+
+impl RankRow<'_> {
+    /// The peak crank–rod pin force, N.
+    pub fn peak_force_n(&self) -> Option<f64> {
+        self.dynamics.map(|d| d.peak_pin_force_n)
+    }
+    /// Where the linear model is out of its depth (beyond yield, large displacement): the short
+    /// names, `; `-joined.
+    pub fn model_validity(&self) -> String {
+        self.fem
+            .map(|f| {
+                f.criterion
+                    .model_validity
+                    .iter()
+                    .map(|m| m.split(':').next().unwrap_or_default())
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            })
+            .unwrap_or_default()
+    }
+}
+
+/// The ranking of a study: every design that passed stage 1, in report order.
+pub fn ranking(results: &StudyResults) -> Vec<RankRow<'_>> {
     let fails = |d: &DesignResult| d.fem.as_ref().is_some_and(|f| !f.criterion.pass);
-    order.sort_by(|a, b| {
+    let mut done: Vec<&DesignResult> = results.designs.iter().collect();
+    done.sort_by(|a, b| {
         fails(a).cmp(&fails(b)).then(
             a.dynamics
                 .peak_pin_force_n
                 .total_cmp(&b.dynamics.peak_pin_force_n),
         )
     });
-    order
+    let mut partial: Vec<&FailedDesign> =
+        results.failed.iter().filter(|f| f.mass.is_some()).collect();
+    let force = |f: &FailedDesign| {
+        f.dynamics
+            .as_ref()
+            .map_or(f64::INFINITY, |d| d.peak_pin_force_n)
+    };
+    partial.sort_by(|a, b| force(a).total_cmp(&force(b)).then(a.file.cmp(&b.file)));
+    let mut rows: Vec<RankRow> = done
+        .into_iter()
+        .enumerate()
+        .map(|(k, d)| RankRow {
+            rank: Some(k + 1),
+            mass: &d.mass,
+            dynamics: Some(&d.dynamics),
+            fem: d.fem.as_ref(),
+            status: match &d.fem {
+                None => Status::NotJudged,
+                Some(f) if f.criterion.pass => Status::Pass,
+                Some(_) => Status::Fail,
+            },
+        })
+        .collect();
+    rows.extend(partial.into_iter().filter_map(|f| {
+        Some(RankRow {
+            rank: None,
+            mass: f.mass.as_ref()?,
+            dynamics: f.dynamics.as_ref(),
+            fem: None,
+            status: Status::StageFailed {
+                stage: f.stage.clone(),
+                error: f.error.clone(),
+            },
+        })
+    }));
+    rows
 }
 
-/// One row of `ranking.csv` (SI units but stresses in MPa; empty where FEM was skipped).
+/// The designs that passed every stage, in ranking order.
+pub fn ranked(results: &StudyResults) -> Vec<&DesignResult> {
+    ranking(results)
+        .into_iter()
+        .filter_map(|r| {
+            results
+                .designs
+                .iter()
+                .find(|d| std::ptr::eq(&d.mass, r.mass))
+        })
+        .collect()
+}
+
+/// One row of `ranking.csv` (SI units but stresses in MPa; empty where a stage was skipped or
+/// failed).
 #[derive(Serialize)]
-struct Row<'a> {
-    rank: usize,
+struct CsvRow<'a> {
+    rank: Option<usize>,
     design: &'a str,
     id: &'a str,
     mass_kg: f64,
     l1_m: f64,
     i_zz_kgm2: f64,
     i_xx_kgm2: f64,
-    peak_pin_force_n: f64,
+    peak_pin_force_n: Option<f64>,
     fx_von_mises_away_from_fixed_mpa: Option<f64>,
     fx_estimated_error_rel: Option<f64>,
     fx_von_mises_averaged_mpa: Option<f64>,
@@ -42,78 +164,124 @@ struct Row<'a> {
     max_displacement_mm: Option<f64>,
     allowed_mpa: Option<f64>,
     safety_factor: Option<f64>,
-    status: &'static str,
+    status: String,
     /// Where the linear model is out of its depth (beyond yield, large displacement), `; `-joined.
     model_validity: String,
-}
-
-fn rows(results: &StudyResults) -> Vec<Row<'_>> {
-    ranked(results)
-        .into_iter()
-        .enumerate()
-        .map(|(k, d)| {
-            let f = d.fem.as_ref();
-            let fx = f.map(|f| &f.fem.fx);
-            let fy = f.map(|f| &f.fem.fy);
-            Row {
-                rank: k + 1,
-                design: &d.mass.design,
-                id: &d.mass.id,
-                mass_kg: d.mass.mass_kg,
-                l1_m: d.mass.l1_m,
-                i_zz_kgm2: d.mass.i_zz_kgm2,
-                i_xx_kgm2: d.mass.i_xx_kgm2,
-                peak_pin_force_n: d.dynamics.peak_pin_force_n,
-                fx_von_mises_away_from_fixed_mpa: fx.map(|c| c.max_von_mises_away_from_fixed_mpa),
-                fx_estimated_error_rel: fx.map(|c| c.estimated_error_rel),
-                fx_von_mises_averaged_mpa: fx.map(|c| c.max_von_mises_averaged_mpa),
-                fx_von_mises_unaveraged_mpa: fx.map(|c| c.max_von_mises_unaveraged_mpa),
-                fy_von_mises_away_from_fixed_mpa: fy.map(|c| c.max_von_mises_away_from_fixed_mpa),
-                fy_estimated_error_rel: fy.map(|c| c.estimated_error_rel),
-                fy_von_mises_averaged_mpa: fy.map(|c| c.max_von_mises_averaged_mpa),
-                fy_von_mises_unaveraged_mpa: fy.map(|c| c.max_von_mises_unaveraged_mpa),
-                max_displacement_mm: f.map(|f| {
-                    f.fem
-                        .fx
-                        .max_displacement_mm
-                        .max(f.fem.fy.max_displacement_mm)
-                }),
-                allowed_mpa: f.map(|f| f.criterion.allowed_mpa),
-                safety_factor: f.map(|f| f.criterion.safety_factor),
-                status: match f {
-                    None => "not judged (FEM skipped)",
-                    Some(f) if f.criterion.pass => "pass",
-                    Some(_) => "fail",
-                },
-                model_validity: f
-                    .map(|f| {
-                        f.criterion
-                            .model_validity
-                            .iter()
-                            .map(|m| m.split(':').next().unwrap_or_default())
-                            .collect::<Vec<_>>()
-                            .join("; ")
-                    })
-                    .unwrap_or_default(),
-            }
-        })
-        .collect()
+    /// The failing stage's message, for a design that did not pass every stage.
+    error: String,
 }
 
 /// `ranking.csv`.
 pub fn csv(results: &StudyResults) -> Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    for row in rows(results) {
-        w.serialize(row)?;
+    for r in ranking(results) {
+        let f = r.fem;
+        let fx = f.map(|f| &f.fem.fx);
+        let fy = f.map(|f| &f.fem.fy);
+        w.serialize(CsvRow {
+            rank: r.rank,
+            design: &r.mass.design,
+            id: &r.mass.id,
+            mass_kg: r.mass.mass_kg,
+            l1_m: r.mass.l1_m,
+            i_zz_kgm2: r.mass.i_zz_kgm2,
+            i_xx_kgm2: r.mass.i_xx_kgm2,
+            peak_pin_force_n: r.peak_force_n(),
+            fx_von_mises_away_from_fixed_mpa: fx.map(|c| c.max_von_mises_away_from_fixed_mpa),
+            fx_estimated_error_rel: fx.map(|c| c.estimated_error_rel),
+            fx_von_mises_averaged_mpa: fx.map(|c| c.max_von_mises_averaged_mpa),
+            fx_von_mises_unaveraged_mpa: fx.map(|c| c.max_von_mises_unaveraged_mpa),
+            fy_von_mises_away_from_fixed_mpa: fy.map(|c| c.max_von_mises_away_from_fixed_mpa),
+            fy_estimated_error_rel: fy.map(|c| c.estimated_error_rel),
+            fy_von_mises_averaged_mpa: fy.map(|c| c.max_von_mises_averaged_mpa),
+            fy_von_mises_unaveraged_mpa: fy.map(|c| c.max_von_mises_unaveraged_mpa),
+            max_displacement_mm: f.map(|f| {
+                f.fem
+                    .fx
+                    .max_displacement_mm
+                    .max(f.fem.fy.max_displacement_mm)
+            }),
+            allowed_mpa: f.map(|f| f.criterion.allowed_mpa),
+            safety_factor: f.map(|f| f.criterion.safety_factor),
+            status: r.status.word(),
+            model_validity: r.model_validity(),
+            error: match &r.status {
+                Status::StageFailed { error, .. } => error.clone(),
+                _ => String::new(),
+            },
+        })?;
     }
     Ok(w.into_inner()?)
 }
 
-/// `ranking.md`.
-pub fn markdown(results: &StudyResults) -> String {
+/// The column headers of the ranking table for people (md and html).
+pub const HEADERS: [&str; 12] = [
+    "rank",
+    "design",
+    "status",
+    "safety factor",
+    "σ F_x [MPa]",
+    "σ F_y [MPa]",
+    "peak pin force [N]",
+    "mass [kg]",
+    "l1 [mm]",
+    "I_zz [kg·m²]",
+    "I_xx [kg·m²]",
+    "max displ. [mm]",
+];
+
+/// The cells of one row of the table for people, in [`HEADERS`] order (plain text).
+pub fn cells(r: &RankRow) -> [String; 12] {
+    let dash = || "—".to_string();
+    let stress = |c: Option<&crate::fem::LoadCaseResult>| {
+        c.map_or_else(dash, |c| {
+            format!(
+                "{:.1} ± {:.1} % / {:.1} / {:.1}",
+                c.max_von_mises_away_from_fixed_mpa,
+                100.0 * c.estimated_error_rel,
+                c.max_von_mises_averaged_mpa,
+                c.max_von_mises_unaveraged_mpa
+            )
+        })
+    };
+    let f = r.fem;
+    let validity = r.model_validity();
+    [
+        r.rank.map_or_else(dash, |k| k.to_string()),
+        r.mass.design.clone(),
+        if validity.is_empty() {
+            r.status.word()
+        } else {
+            format!("{} ({validity})", r.status.word())
+        },
+        f.map_or_else(dash, |f| format!("{:.2}", f.criterion.safety_factor)),
+        stress(f.map(|f| &f.fem.fx)),
+        stress(f.map(|f| &f.fem.fy)),
+        r.peak_force_n().map_or_else(dash, |v| format!("{v:.1}")),
+        format!("{:.4}", r.mass.mass_kg),
+        format!("{:.2}", r.mass.l1_m * 1e3),
+        format!("{:.5}", r.mass.i_zz_kgm2),
+        format!("{:.6}", r.mass.i_xx_kgm2),
+        f.map_or_else(dash, |f| {
+            format!(
+                "{:.4}",
+                f.fem
+                    .fx
+                    .max_displacement_mm
+                    .max(f.fem.fy.max_displacement_mm)
+            )
+        }),
+    ]
+}
+
+/// The sentence that says how the ranking orders and what the stress columns hold.
+pub fn explanation(results: &StudyResults) -> String {
     let c = &results.config.criterion;
-    let mut out = format!(
-        "# Ranking of the designs\n\nDesigns that meet the stress criterion first (max von Mises away from the fixed bore ≤ yield {} MPa / safety factor {} = {:.1} MPa, in both the F_x and F_y cases{}), then by the peak crank–rod pin force of the driven crank–slider, lowest first. Stresses [MPa] per case: away from the fixed bore and from sharp re-entrant edges (the convergent measure, judged) ± its estimated error / nodally averaged / raw element-nodal peak (at the fixed edge, a singularity, shown for reference).\n\n| rank | design | mass [kg] | l1 [mm] | I_zz [kg·m²] | I_xx [kg·m²] | peak pin force [N] | σ F_x [MPa] | σ F_y [MPa] | max displ. [mm] | safety factor | status |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+    if results.stages_skipped.iter().any(|s| s == "fem") {
+        return "The FEM stage was skipped: no design is judged on stress; ranked by the peak crank–rod pin force of the driven crank–slider, lowest first.".into();
+    }
+    format!(
+        "Designs that meet the stress criterion first (max von Mises away from the fixed bore ≤ yield {} MPa / safety factor {} = {:.1} MPa, in both the F_x and F_y cases{}), then by the peak crank–rod pin force of the driven crank–slider, lowest first; a design whose FEM stage failed keeps its mass and force but is not ranked. Stresses [MPa] per case: away from the fixed bore and from sharp re-entrant edges (the convergent measure, judged) ± its estimated error / nodally averaged / raw element-nodal peak (at the fixed edge, a singularity, shown for reference).",
         c.yield_mpa,
         c.safety_factor,
         c.yield_mpa / c.safety_factor,
@@ -122,71 +290,88 @@ pub fn markdown(results: &StudyResults) -> String {
         } else {
             ""
         }
-    );
-    let triple = |a: Option<f64>, e: Option<f64>, b: Option<f64>, c: Option<f64>| match (a, e, b, c)
-    {
-        (Some(a), Some(e), Some(b), Some(c)) => {
-            format!("{a:.1} ± {:.1} % / {b:.1} / {c:.1}", 100.0 * e)
-        }
-        _ => "—".into(),
-    };
-    for r in rows(results) {
-        out.push_str(&format!(
-            "| {} | {} | {:.4} | {:.2} | {:.5} | {:.6} | {:.1} | {} | {} | {} | {} | {} |\n",
-            r.rank,
-            r.design,
-            r.mass_kg,
-            r.l1_m * 1e3,
-            r.i_zz_kgm2,
-            r.i_xx_kgm2,
-            r.peak_pin_force_n,
-            triple(
-                r.fx_von_mises_away_from_fixed_mpa,
-                r.fx_estimated_error_rel,
-                r.fx_von_mises_averaged_mpa,
-                r.fx_von_mises_unaveraged_mpa
-            ),
-            triple(
-                r.fy_von_mises_away_from_fixed_mpa,
-                r.fy_estimated_error_rel,
-                r.fy_von_mises_averaged_mpa,
-                r.fy_von_mises_unaveraged_mpa
-            ),
-            r.max_displacement_mm
-                .map_or("—".into(), |v| format!("{v:.4}")),
-            r.safety_factor.map_or("—".into(), |v| format!("{v:.2}")),
-            if r.model_validity.is_empty() {
-                r.status.to_string()
-            } else {
-                format!("{} ({})", r.status, r.model_validity)
-            }
-        ));
-    }
-    let notes: Vec<String> = results
-        .designs
-        .iter()
-        .filter_map(|d| d.fem.as_ref().map(|f| (d, f)))
+    )
+}
+
+/// Per design, the sentences that say where the model is out of its depth.
+pub fn validity_notes(results: &StudyResults) -> Vec<(String, String)> {
+    ranking(results)
+        .into_iter()
+        .filter_map(|r| r.fem.map(|f| (r.mass.design.clone(), f)))
         .flat_map(|(d, f)| {
             f.criterion
                 .model_validity
                 .iter()
-                .map(move |m| format!("- {}: {m}", d.mass.design))
+                .map(move |m| (d.clone(), m.clone()))
         })
-        .collect();
+        .collect()
+}
+
+/// The sentence above the out-of-depth list.
+pub const VALIDITY_PREAMBLE: &str = "The stage-3 model is linear elastic and small-displacement; these figures are beyond it (the verdict stands, the numbers are not to be read as the part's stress or deflection):";
+
+/// `ranking.md`.
+pub fn markdown(results: &StudyResults) -> String {
+    let mut out = format!("# Ranking of the designs\n\n{}\n\n", explanation(results));
+    out.push_str(&format!("| {} |\n", HEADERS.join(" | ")));
+    out.push_str(&format!("|{}\n", "---|".repeat(HEADERS.len())));
+    for r in ranking(results) {
+        let cells = cells(&r).map(|c| c.replace('|', "\\|"));
+        out.push_str(&format!("| {} |\n", cells.join(" | ")));
+    }
+    let notes = validity_notes(results);
     if !notes.is_empty() {
-        out.push_str(
-            "\n## Out of the model's depth\n\nThe stage-3 model is linear elastic and small-displacement; these figures are beyond it (the verdict stands, the numbers are not to be read as the part's stress or deflection):\n\n",
-        );
-        for n in notes {
-            out.push_str(&n);
-            out.push('\n');
+        out.push_str(&format!(
+            "\n## Out of the model's depth\n\n{VALIDITY_PREAMBLE}\n\n"
+        ));
+        for (d, m) in notes {
+            out.push_str(&format!("- {d}: {m}\n"));
         }
     }
     if !results.failed.is_empty() {
         out.push_str("\n## Failed designs\n\n");
         for f in &results.failed {
-            out.push_str(&format!("- `{}`: {}\n", f.file, f.error));
+            out.push_str(&format!(
+                "- `{}` ({} stage): {}\n",
+                f.file, f.stage, f.error
+            ));
         }
     }
+    out
+}
+
+/// Escapes text for html.
+pub fn escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// The ranking as an html table (`<table id="ranking">`, one `<tr data-id="…">` per design in
+/// ranking order); the design names link to their sections (`#<id>`).
+pub fn html_table(results: &StudyResults) -> String {
+    let mut out = String::from("<table id=\"ranking\">\n<thead><tr>");
+    for h in HEADERS {
+        out.push_str(&format!("<th>{}</th>", escape(h)));
+    }
+    out.push_str("</tr></thead>\n<tbody>\n");
+    for r in ranking(results) {
+        let id = escape(&r.mass.id);
+        out.push_str(&format!(
+            "<tr data-id=\"{id}\" class=\"{}\">",
+            r.status.class()
+        ));
+        for (k, c) in cells(&r).iter().enumerate() {
+            let c = escape(c);
+            if k == 1 {
+                out.push_str(&format!("<td><a href=\"#{id}\">{c}</a></td>"));
+            } else {
+                out.push_str(&format!("<td>{c}</td>"));
+            }
+        }
+        out.push_str("</tr>\n");
+    }
+    out.push_str("</tbody></table>\n");
     out
 }
