@@ -22,9 +22,8 @@
 use super::control::{check_underflow, initial_step, max_step, min_step};
 use super::eval::Evaluator;
 use super::grid::Recorder;
-use super::lu::IterationMatrix;
 use super::method::{check_input, invalid};
-use super::newton::Newton;
+use super::newton::{IterationMatrix, Newton, iteration_matrix};
 use super::norm::{Weights, rms_norm};
 use super::{OdeSystem, OutputGrid, Solution, SolverError, SolverOptions};
 use nalgebra::{DMatrix, DVector};
@@ -191,7 +190,7 @@ pub fn solve<S: OdeSystem + ?Sized>(
             loop {
                 if lu.is_none() {
                     ev.stats.lu_decompositions += 1;
-                    lu = IterationMatrix::new(&jac, c);
+                    lu = iteration_matrix(&jac, c);
                 }
                 if let Some(w) = lu.as_ref() {
                     y_new.copy_from(&y_pred);

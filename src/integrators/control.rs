@@ -86,3 +86,23 @@ pub(crate) fn factor(err: f64, q: f64, safety: f64, fac_min: f64, fac_max: f64) 
     }
     (safety * err.powf(-1.0 / q)).clamp(fac_min, fac_max)
 }
+
+/// An elementary step-size controller: [`factor`] with the method's error exponent, safety
+/// factor and smallest factor (the largest is set by the loop, see
+/// [`super::adaptive::FAC_MAX`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Controller {
+    /// `q` of `err^(-1/q)`: the order of the error estimate plus one.
+    pub(crate) exponent: f64,
+    /// Safety factor.
+    pub(crate) safety: f64,
+    /// Smallest factor.
+    pub(crate) fac_min: f64,
+}
+
+impl Controller {
+    /// [`factor`] of this controller, at most `fac_max`.
+    pub(crate) fn factor(&self, err: f64, fac_max: f64) -> f64 {
+        factor(err, self.exponent, self.safety, self.fac_min, fac_max)
+    }
+}

@@ -16,6 +16,14 @@
 //! at most 1. With `rtol = 0` the control is purely absolute, which is what a growing angle
 //! needs (a relative tolerance on φ loosens as φ grows).
 //!
+//! The adaptive one-step methods ([`rk45`], [`rk23`], [`rosenbrock`], [`trbdf2`]) share one
+//! step-size loop (`adaptive.rs`: accept/reject, step-size control, dense output onto the
+//! grid, caps, the optional post-step projection); each method's file holds only its tableau,
+//! stages, error estimate, controller constants and continuous extension. [`bdf`] keeps its
+//! own loop (variable order; its backward differences are rescaled at every step change).
+//! The iteration matrices `I − γhJ` of the implicit methods are factored by the crate's one
+//! dense LU, [`crate::mechanism::lu::DenseLu`].
+//!
 //! Methods (one file each):
 //! - [`initial_acceleration`]: the thesis' "initial acceleration" method (§4.1.1, eq. 4.5–4.13),
 //!   fixed step, for second-order systems in the layout `y = [q; q̇]`;
@@ -40,15 +48,17 @@
 //! `ode_solvers` 0.6 was avoided for its wrong last dense-output point, `russell_ode` lacks
 //! BS23 and Rosenbrock.
 
+mod adaptive;
 mod control;
 mod error;
 mod eval;
 mod grid;
-mod lu;
 mod newton;
 mod norm;
 mod options;
 mod projection;
+#[cfg(test)]
+mod regression;
 mod stats;
 mod system;
 #[cfg(test)]

@@ -3,10 +3,29 @@
 //! the same test as ode15s and SciPy's BDF).
 
 use super::eval::Evaluator;
-use super::lu::IterationMatrix;
 use super::norm::rms_norm;
 use super::{OdeSystem, SolverError};
-use nalgebra::DVector;
+use crate::mechanism::lu::DenseLu;
+use nalgebra::{DMatrix, DVector, Dyn};
+
+/// LU factors (partial pivoting) of an iteration matrix `W = I − c J`, by the crate's one
+/// dense LU ([`DenseLu`]); [`DenseLu::solve_mut`] reports a singular `W` or a non-finite
+/// result as `false`.
+pub(crate) type IterationMatrix = DenseLu<Dyn>;
+
+/// Factors `I − c J`; `None` if singular or not finite.
+pub(crate) fn iteration_matrix(jac: &DMatrix<f64>, c: f64) -> Option<IterationMatrix> {
+    let n = jac.nrows();
+    let mut m = jac * (-c);
+    for i in 0..n {
+        m[(i, i)] += 1.0;
+    }
+    if !m.iter().all(|v| v.is_finite()) {
+        return None;
+    }
+    let lu = DenseLu::Partial(m.lu());
+    lu.is_invertible().then_some(lu)
+}
 
 /// Work vectors and settings of the iteration.
 pub(crate) struct Newton {

@@ -8,15 +8,12 @@
 //! error `h (−5/72 k1 + 1/12 k2 + 1/9 k3 − 1/8 k4)`; step factor `0.9 err^(-1/3)` in `[0.2, 5]`.
 //! Dense output: cubic Hermite interpolation of `(y, k1)` and `(y_new, k4)` (3rd order, as ode23).
 
-use super::control::{check_underflow, clamp_to_end, factor, initial_step, max_step};
+use super::adaptive::{AdaptiveStepper, Attempt, Step, integrate};
+use super::control::Controller;
 use super::eval::Evaluator;
-use super::grid::Recorder;
-use super::method::{check_input, invalid};
 use super::norm::{Weights, all_finite};
 use super::{OdeSystem, OutputGrid, Solution, SolverError, SolverOptions};
 use nalgebra::DVector;
-
-const NAME: &str = "rk23";
 
 /// Cubic Hermite interpolation on `[t, t + h]` at `θ`: writes into `out`.
 pub(crate) fn hermite(
@@ -46,74 +43,80 @@ pub fn solve<S: OdeSystem + ?Sized>(
     grid: &OutputGrid,
     opts: &SolverOptions,
 ) -> Result<Solution, SolverError> {
-    let (t0, t_end) = (grid.t0, grid.t_end());
-    check_input(sys, y0, opts).map_err(|m| invalid(NAME, t0, m))?;
-    let n = y0.len();
-    let weights = Weights::new(opts, n);
-    let mut ev = Evaluator::new(sys, NAME, opts, t0);
-    let mut rec = Recorder::new(grid, y0);
-    let h_max = max_step(opts, t_end - t0);
-    let (mut k1, mut k2, mut k3, mut k4) = (
-        DVector::zeros(n),
-        DVector::zeros(n),
-        DVector::zeros(n),
-        DVector::zeros(n),
-    );
-    let mut y = y0.clone();
-    let mut y_new = DVector::zeros(n);
-    let mut ys = DVector::zeros(n);
-    let mut err = DVector::zeros(n);
-    ev.rhs_finite(t0, &y, &mut k1)?;
-    let mut h = initial_step(&mut ev, t0, &y, &k1, 2, t_end - t0, opts)?;
-    let mut t = t0;
-    let mut rejected_last = false;
-    loop {
-        ev.check_step_budget()?;
-        check_underflow(&ev, t, h)?;
-        let (h_step, t_new, last) = clamp_to_end(t, h, t_end);
-        ys.copy_from(&y);
-        ys.axpy(0.5 * h_step, &k1, 1.0);
-        ev.rhs(t + 0.5 * h_step, &ys, &mut k2)?;
-        ys.copy_from(&y);
-        ys.axpy(0.75 * h_step, &k2, 1.0);
-        ev.rhs(t + 0.75 * h_step, &ys, &mut k3)?;
-        for i in 0..n {
-            y_new[i] = y[i] + h_step * (2.0 / 9.0 * k1[i] + 1.0 / 3.0 * k2[i] + 4.0 / 9.0 * k3[i]);
+    integrate::<BogackiShampine, _>(sys, y0, grid, opts, None)
+}
+
+/// Stages `k1 … k4` (`k1 = f(t_n, y_n)`, `k4 = f(t_{n+1}, y_{n+1})`) and scratch.
+struct BogackiShampine {
+    k: [DVector<f64>; 4],
+    ys: DVector<f64>,
+    err: DVector<f64>,
+}
+
+impl AdaptiveStepper for BogackiShampine {
+    const NAME: &'static str = "rk23";
+    const START_ORDER: u32 = 2;
+    const CONTROL: Controller = Controller {
+        exponent: 3.0,
+        safety: 0.9,
+        fac_min: 0.2,
+    };
+
+    fn new(n: usize, _weights: &Weights) -> Self {
+        Self {
+            k: std::array::from_fn(|_| DVector::zeros(n)),
+            ys: DVector::zeros(n),
+            err: DVector::zeros(n),
         }
-        ev.rhs(t_new, &y_new, &mut k4)?;
-        for i in 0..n {
-            err[i] = h_step
+    }
+
+    fn derivative_mut(&mut self) -> &mut DVector<f64> {
+        &mut self.k[0]
+    }
+
+    fn attempt<S: OdeSystem + ?Sized>(
+        &mut self,
+        ev: &mut Evaluator<'_, S>,
+        weights: &Weights,
+        step: &Step,
+        y: &DVector<f64>,
+        y_new: &mut DVector<f64>,
+    ) -> Result<Attempt, SolverError> {
+        let Step { t, h, t_new } = *step;
+        let ([k1, k2, k3, k4], ys, err) = (&mut self.k, &mut self.ys, &mut self.err);
+        ys.copy_from(y);
+        ys.axpy(0.5 * h, k1, 1.0);
+        ev.rhs(t + 0.5 * h, ys, k2)?;
+        ys.copy_from(y);
+        ys.axpy(0.75 * h, k2, 1.0);
+        ev.rhs(t + 0.75 * h, ys, k3)?;
+        for i in 0..y.len() {
+            y_new[i] = y[i] + h * (2.0 / 9.0 * k1[i] + 1.0 / 3.0 * k2[i] + 4.0 / 9.0 * k3[i]);
+        }
+        ev.rhs(t_new, y_new, k4)?;
+        for i in 0..y.len() {
+            err[i] = h
                 * (-5.0 / 72.0 * k1[i] + 1.0 / 12.0 * k2[i] + 1.0 / 9.0 * k3[i]
                     - 1.0 / 8.0 * k4[i]);
         }
-        let en = weights.norm(&err, &y, &y_new);
-        if !en.is_finite() || !all_finite(&y_new) || !all_finite(&k4) {
-            ev.reject_step();
-            h = 0.2 * h_step;
-            rejected_last = true;
-            continue;
-        }
-        if en > 1.0 {
-            ev.reject_step();
-            h = h_step * factor(en, 3.0, 0.9, 0.2, 1.0);
-            rejected_last = true;
-            continue;
-        }
-        rec.record(t, t_new, &y_new, |theta, out| {
-            hermite(theta, h_step, &y, &k1, &y_new, &k4, out)
-        });
-        ev.accept_step(t_new);
-        if last {
-            break;
-        }
-        let fac_max = if rejected_last { 1.0 } else { 5.0 };
-        h = (h_step * factor(en, 3.0, 0.9, 0.2, fac_max)).min(h_max);
-        rejected_last = false;
-        t = t_new;
-        std::mem::swap(&mut y, &mut y_new);
-        std::mem::swap(&mut k1, &mut k4);
+        let en = weights.norm(err, y, y_new);
+        Ok(Attempt::checked(en, all_finite(y_new) && all_finite(k4)))
     }
-    Ok(rec.finish(ev.stats))
+
+    fn interpolate(
+        &self,
+        theta: f64,
+        h: f64,
+        y: &DVector<f64>,
+        y_new: &DVector<f64>,
+        out: &mut DVector<f64>,
+    ) {
+        hermite(theta, h, y, &self.k[0], y_new, &self.k[3], out)
+    }
+
+    fn accept(&mut self) {
+        self.k.swap(0, 3);
+    }
 }
 
 #[cfg(test)]

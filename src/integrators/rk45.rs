@@ -19,17 +19,12 @@
 //! manifold, and differ from the unprojected interpolant by O(local error), which keeps its
 //! 4th order.
 
-use super::control::{check_underflow, clamp_to_end, factor, initial_step, max_step};
+use super::adaptive::{AdaptiveStepper, Attempt, Step, integrate};
+use super::control::Controller;
 use super::eval::Evaluator;
-use super::grid::Recorder;
-use super::method::{check_input, invalid};
 use super::norm::{Weights, all_finite};
-use super::{
-    FailureKind, OdeSystem, OutputGrid, Solution, SolverError, SolverOptions, StepProjection,
-};
+use super::{OdeSystem, OutputGrid, Solution, SolverError, SolverOptions, StepProjection};
 use nalgebra::DVector;
-
-const NAME: &str = "rk45";
 
 const C: [f64; 7] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0];
 const A: [[f64; 6]; 7] = [
@@ -62,7 +57,7 @@ const A: [[f64; 6]; 7] = [
         11.0 / 84.0,
     ],
 ];
-/// `e = b − b̂` (b = A[6], 5th order; b̂ the 4th-order weights).
+/// `e = b − b̂` (`b = A[6]`, 5th order; `b̂` the 4th-order weights).
 const E: [f64; 7] = [
     71.0 / 57600.0,
     0.0,
@@ -90,12 +85,12 @@ pub fn solve<S: OdeSystem + ?Sized>(
     grid: &OutputGrid,
     opts: &SolverOptions,
 ) -> Result<Solution, SolverError> {
-    integrate(sys, y0, grid, opts, None)
+    integrate::<DormandPrince, _>(sys, y0, grid, opts, None)
 }
 
 /// [`solve`] with a projection onto an invariant manifold after every accepted step, applied
 /// to `y0` and to every dense-output sample as well (see the module docs). A failed projection
-/// stops the run with [`FailureKind::Projection`].
+/// stops the run with [`FailureKind::Projection`](super::FailureKind::Projection).
 pub fn solve_projected<S: OdeSystem + ?Sized>(
     sys: &S,
     y0: &DVector<f64>,
@@ -103,44 +98,48 @@ pub fn solve_projected<S: OdeSystem + ?Sized>(
     opts: &SolverOptions,
     projection: &mut dyn StepProjection,
 ) -> Result<Solution, SolverError> {
-    integrate(sys, y0, grid, opts, Some(projection))
+    integrate::<DormandPrince, _>(sys, y0, grid, opts, Some(projection))
 }
 
-fn integrate<S: OdeSystem + ?Sized>(
-    sys: &S,
-    y0: &DVector<f64>,
-    grid: &OutputGrid,
-    opts: &SolverOptions,
-    mut proj: Option<&mut dyn StepProjection>,
-) -> Result<Solution, SolverError> {
-    let (t0, t_end) = (grid.t0, grid.t_end());
-    check_input(sys, y0, opts).map_err(|m| invalid(NAME, t0, m))?;
-    let n = y0.len();
-    let weights = Weights::new(opts, n);
-    let mut ev = Evaluator::new(sys, NAME, opts, t0);
-    let mut y0 = y0.clone();
-    if let Some(p) = proj.as_deref_mut() {
-        p.project(t0, &mut y0)
-            .map_err(|m| ev.fail(FailureKind::Projection(m)))?;
+/// Stages `k_1 … k_7` (`k_1 = f(t_n, y_n)`, `k_7 = f(t_{n+1}, y_{n+1})`) and scratch.
+struct DormandPrince {
+    k: [DVector<f64>; 7],
+    ys: DVector<f64>,
+    err: DVector<f64>,
+}
+
+impl AdaptiveStepper for DormandPrince {
+    const NAME: &'static str = "rk45";
+    const START_ORDER: u32 = 4;
+    const CONTROL: Controller = Controller {
+        exponent: 5.0,
+        safety: 0.9,
+        fac_min: 0.2,
+    };
+
+    fn new(n: usize, _weights: &Weights) -> Self {
+        Self {
+            k: std::array::from_fn(|_| DVector::zeros(n)),
+            ys: DVector::zeros(n),
+            err: DVector::zeros(n),
+        }
     }
-    let y0 = &y0;
-    let mut rec = Recorder::new(grid, y0);
-    let mut y_proj = DVector::zeros(n);
-    let mut proj_failure = None;
-    let h_max = max_step(opts, t_end - t0);
-    let mut k: [DVector<f64>; 7] = std::array::from_fn(|_| DVector::zeros(n));
-    let mut y = y0.clone();
-    let mut y_new = DVector::zeros(n);
-    let mut ys = DVector::zeros(n);
-    let mut err = DVector::zeros(n);
-    ev.rhs_finite(t0, &y, &mut k[0])?;
-    let mut h = initial_step(&mut ev, t0, &y, &k[0], 4, t_end - t0, opts)?;
-    let mut t = t0;
-    let mut rejected_last = false;
-    loop {
-        ev.check_step_budget()?;
-        check_underflow(&ev, t, h)?;
-        let (h_step, t_new, last) = clamp_to_end(t, h, t_end);
+
+    fn derivative_mut(&mut self) -> &mut DVector<f64> {
+        &mut self.k[0]
+    }
+
+    fn attempt<S: OdeSystem + ?Sized>(
+        &mut self,
+        ev: &mut Evaluator<'_, S>,
+        weights: &Weights,
+        step: &Step,
+        y: &DVector<f64>,
+        y_new: &mut DVector<f64>,
+    ) -> Result<Attempt, SolverError> {
+        let Step { t, h, t_new } = *step;
+        let Self { k, ys, err } = self;
+        let n = y.len();
         for s in 1..7 {
             // component loops: cheaper than vector ops for the small systems of this crate
             for i in 0..n {
@@ -148,79 +147,51 @@ fn integrate<S: OdeSystem + ?Sized>(
                 for (j, kj) in k.iter().enumerate().take(s) {
                     acc += A[s][j] * kj[i];
                 }
-                ys[i] = y[i] + h_step * acc;
+                ys[i] = y[i] + h * acc;
             }
-            let ts = if s >= 5 { t_new } else { t + C[s] * h_step };
-            ev.rhs(ts, &ys, &mut k[s])?;
+            let ts = if s >= 5 { t_new } else { t + C[s] * h };
+            ev.rhs(ts, ys, &mut k[s])?;
         }
         // stage 7 was evaluated at y_new = ys (FSAL)
-        y_new.copy_from(&ys);
+        y_new.copy_from(ys);
         for i in 0..n {
             let mut acc = 0.0;
             for (j, kj) in k.iter().enumerate() {
                 acc += E[j] * kj[i];
             }
-            err[i] = h_step * acc;
+            err[i] = h * acc;
         }
-        let en = weights.norm(&err, &y, &y_new);
-        if !en.is_finite() || !all_finite(&y_new) || !all_finite(&k[6]) {
-            ev.reject_step();
-            h = 0.2 * h_step;
-            rejected_last = true;
-            continue;
-        }
-        if en > 1.0 {
-            ev.reject_step();
-            h = h_step * factor(en, 5.0, 0.9, 0.2, 1.0);
-            rejected_last = true;
-            continue;
-        }
-        if let Some(p) = proj.as_deref_mut() {
-            y_proj.copy_from(&y_new);
-            p.project(t_new, &mut y_proj)
-                .map_err(|m| ev.fail(FailureKind::Projection(m)))?;
-        }
-        let y_out = if proj.is_some() { &y_proj } else { &y_new };
-        rec.record(t, t_new, y_out, |theta, out| {
-            let (t1, t2, t3, t4) = (theta, theta * theta, theta.powi(3), theta.powi(4));
-            out.copy_from(&y);
-            for (j, kj) in k.iter().enumerate() {
-                let b = BI[j][0] * t1 + BI[j][1] * t2 + BI[j][2] * t3 + BI[j][3] * t4;
-                if b != 0.0 {
-                    out.axpy(h_step * b, kj, 1.0);
-                }
-            }
-            if let Some(p) = proj.as_deref_mut()
-                && let Err(m) = p.project(t + theta * h_step, out)
-            {
-                proj_failure.get_or_insert(m);
-            }
-        });
-        if let Some(m) = proj_failure.take() {
-            return Err(ev.fail(FailureKind::Projection(m)));
-        }
-        ev.accept_step(t_new);
-        if last {
-            break;
-        }
-        if proj.is_some() {
-            // the FSAL stage belongs to the unprojected ỹ_{n+1}: re-evaluate at y_{n+1}
-            y_new.copy_from(&y_proj);
-            ev.rhs_finite(t_new, &y_new, &mut k[6])?;
-        }
-        let fac_max = if rejected_last { 1.0 } else { 5.0 };
-        h = (h_step * factor(en, 5.0, 0.9, 0.2, fac_max)).min(h_max);
-        rejected_last = false;
-        t = t_new;
-        std::mem::swap(&mut y, &mut y_new);
-        k.swap(0, 6);
+        let en = weights.norm(err, y, y_new);
+        Ok(Attempt::checked(en, all_finite(y_new) && all_finite(&k[6])))
     }
-    Ok(rec.finish(ev.stats))
+
+    fn interpolate(
+        &self,
+        theta: f64,
+        h: f64,
+        y: &DVector<f64>,
+        _y_new: &DVector<f64>,
+        out: &mut DVector<f64>,
+    ) {
+        let (t1, t2, t3, t4) = (theta, theta * theta, theta.powi(3), theta.powi(4));
+        out.copy_from(y);
+        for (j, kj) in self.k.iter().enumerate() {
+            let b = BI[j][0] * t1 + BI[j][1] * t2 + BI[j][2] * t3 + BI[j][3] * t4;
+            if b != 0.0 {
+                out.axpy(h * b, kj, 1.0);
+            }
+        }
+    }
+
+    fn accept(&mut self) {
+        self.k.swap(0, 6);
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::integrators::FailureKind;
     use crate::integrators::tests_common::{Decay, Oscillator, max_error};
 
     #[test]

@@ -16,16 +16,18 @@
 //! ode23s does), `T` by a forward difference unless the system declares itself autonomous.
 //! Dense output: `y(t + θh) = y + h [θ(1−θ)/(1−2d) k1 + θ(θ−2d)/(1−2d) k2]`.
 
-use super::control::{check_underflow, clamp_to_end, initial_step, max_step};
+use super::adaptive::{AdaptiveStepper, Attempt, Step, integrate};
+use super::control::Controller;
 use super::eval::Evaluator;
-use super::grid::Recorder;
-use super::lu::IterationMatrix;
-use super::method::{check_input, invalid};
+use super::newton::iteration_matrix;
 use super::norm::{Weights, all_finite};
 use super::{OdeSystem, OutputGrid, Solution, SolverError, SolverOptions};
 use nalgebra::{DMatrix, DVector};
+use std::f64::consts::SQRT_2;
 
-const NAME: &str = "rosenbrock";
+/// `d = 1/(2 + √2)`, `e32 = 6 + √2`.
+const D: f64 = 1.0 / (2.0 + SQRT_2);
+const E32: f64 = 6.0 + SQRT_2;
 
 /// Integrates with error control `opts.rtol`, `opts.atol`.
 pub fn solve<S: OdeSystem + ?Sized>(
@@ -34,110 +36,129 @@ pub fn solve<S: OdeSystem + ?Sized>(
     grid: &OutputGrid,
     opts: &SolverOptions,
 ) -> Result<Solution, SolverError> {
-    let (t0, t_end) = (grid.t0, grid.t_end());
-    check_input(sys, y0, opts).map_err(|m| invalid(NAME, t0, m))?;
-    let n = y0.len();
-    let weights = Weights::new(opts, n);
-    let d = 1.0 / (2.0 + 2f64.sqrt());
-    let e32 = 6.0 + 2f64.sqrt();
-    let mut ev = Evaluator::new(sys, NAME, opts, t0);
-    let mut rec = Recorder::new(grid, y0);
-    let h_max = max_step(opts, t_end - t0);
-    let mut y = y0.clone();
-    let mut f0 = DVector::zeros(n);
-    ev.rhs_finite(t0, &y, &mut f0)?;
-    let mut h = initial_step(&mut ev, t0, &y, &f0, 2, t_end - t0, opts)?;
-    let mut jac = DMatrix::zeros(n, n);
-    let mut tder = DVector::zeros(n);
-    let (mut k1, mut k2, mut k3) = (DVector::zeros(n), DVector::zeros(n), DVector::zeros(n));
-    let (mut f1, mut f2) = (DVector::zeros(n), DVector::zeros(n));
-    let mut ys = DVector::zeros(n);
-    let mut y_new = DVector::zeros(n);
-    let mut err = DVector::zeros(n);
-    let mut t = t0;
-    let mut jac_current_at = f64::NAN;
-    loop {
-        ev.check_step_budget()?;
-        if jac_current_at != t {
-            ev.jacobian(t, &y, Some(&f0), &mut jac)?;
-            ev.time_derivative(t, &y, &f0, &mut tder)?;
-            jac_current_at = t;
+    integrate::<Rosenbrock23, _>(sys, y0, grid, opts, None)
+}
+
+/// `J`, `T` at the start of the step, stages `k1 … k3`, derivatives `F0 … F2`
+/// (`F0 = f(t_n, y_n)`, `F2 = f(t_{n+1}, y_{n+1})`) and scratch.
+struct Rosenbrock23 {
+    jac: DMatrix<f64>,
+    tder: DVector<f64>,
+    /// Time at which `jac` and `tder` were evaluated.
+    jac_current_at: f64,
+    k: [DVector<f64>; 3],
+    f: [DVector<f64>; 3],
+    ys: DVector<f64>,
+    err: DVector<f64>,
+}
+
+impl AdaptiveStepper for Rosenbrock23 {
+    const NAME: &'static str = "rosenbrock";
+    const START_ORDER: u32 = 2;
+    /// ode23s: `0.8 err^(-1/3)`, at least 0.5 on rejection.
+    const CONTROL: Controller = Controller {
+        exponent: 3.0,
+        safety: 0.8,
+        fac_min: 0.5,
+    };
+
+    fn new(n: usize, _weights: &Weights) -> Self {
+        Self {
+            jac: DMatrix::zeros(n, n),
+            tder: DVector::zeros(n),
+            jac_current_at: f64::NAN,
+            k: std::array::from_fn(|_| DVector::zeros(n)),
+            f: std::array::from_fn(|_| DVector::zeros(n)),
+            ys: DVector::zeros(n),
+            err: DVector::zeros(n),
         }
-        let mut rejected = false;
-        let (t_new, h_step, last, en) = loop {
-            check_underflow(&ev, t, h)?;
-            let (h_step, t_new, last) = clamp_to_end(t, h, t_end);
-            ev.stats.lu_decompositions += 1;
-            let Some(w) = IterationMatrix::new(&jac, h_step * d) else {
-                ev.reject_step();
-                h = 0.5 * h_step;
-                rejected = true;
-                continue;
-            };
-            let hd = h_step * d;
-            k1.copy_from(&f0);
-            k1.axpy(hd, &tder, 1.0);
-            let mut ok = w.solve_mut(&mut k1);
-            ys.copy_from(&y);
-            ys.axpy(0.5 * h_step, &k1, 1.0);
-            ev.rhs(t + 0.5 * h_step, &ys, &mut f1)?;
-            k2.copy_from(&f1);
-            k2 -= &k1;
-            ok &= w.solve_mut(&mut k2);
-            k2 += &k1;
-            y_new.copy_from(&y);
-            y_new.axpy(h_step, &k2, 1.0);
-            ev.rhs(t_new, &y_new, &mut f2)?;
-            for i in 0..n {
-                k3[i] = f2[i] - e32 * (k2[i] - f1[i]) - 2.0 * (k1[i] - f0[i]) + hd * tder[i];
-            }
-            ok &= w.solve_mut(&mut k3);
-            for i in 0..n {
-                err[i] = h_step / 6.0 * (k1[i] - 2.0 * k2[i] + k3[i]);
-            }
-            let en = weights.norm(&err, &y, &y_new);
-            if !ok || !en.is_finite() || !all_finite(&y_new) || !all_finite(&f2) {
-                ev.reject_step();
-                h = 0.2 * h_step;
-                rejected = true;
-                continue;
-            }
-            if en > 1.0 {
-                ev.reject_step();
-                h = h_step * (0.8 * en.powf(-1.0 / 3.0)).max(0.5);
-                rejected = true;
-                continue;
-            }
-            break (t_new, h_step, last, en);
-        };
-        let denom = 1.0 - 2.0 * d;
-        rec.record(t, t_new, &y_new, |theta, out| {
-            let a = theta * (1.0 - theta) / denom;
-            let b = theta * (theta - 2.0 * d) / denom;
-            for i in 0..n {
-                out[i] = y[i] + h_step * (a * k1[i] + b * k2[i]);
-            }
-        });
-        ev.accept_step(t_new);
-        if last {
-            break;
-        }
-        let grow = if en == 0.0 {
-            5.0
-        } else {
-            (0.8 * en.powf(-1.0 / 3.0)).min(5.0)
-        };
-        h = if rejected {
-            h_step * grow.min(1.0)
-        } else {
-            h_step * grow
-        }
-        .min(h_max);
-        t = t_new;
-        std::mem::swap(&mut y, &mut y_new);
-        std::mem::swap(&mut f0, &mut f2);
     }
-    Ok(rec.finish(ev.stats))
+
+    fn derivative_mut(&mut self) -> &mut DVector<f64> {
+        &mut self.f[0]
+    }
+
+    /// `J` and `T` once per step.
+    fn begin_step<S: OdeSystem + ?Sized>(
+        &mut self,
+        ev: &mut Evaluator<'_, S>,
+        t: f64,
+        y: &DVector<f64>,
+    ) -> Result<(), SolverError> {
+        if self.jac_current_at != t {
+            ev.jacobian(t, y, Some(&self.f[0]), &mut self.jac)?;
+            ev.time_derivative(t, y, &self.f[0], &mut self.tder)?;
+            self.jac_current_at = t;
+        }
+        Ok(())
+    }
+
+    fn attempt<S: OdeSystem + ?Sized>(
+        &mut self,
+        ev: &mut Evaluator<'_, S>,
+        weights: &Weights,
+        step: &Step,
+        y: &DVector<f64>,
+        y_new: &mut DVector<f64>,
+    ) -> Result<Attempt, SolverError> {
+        let Step { t, h, t_new } = *step;
+        ev.stats.lu_decompositions += 1;
+        let Some(w) = iteration_matrix(&self.jac, h * D) else {
+            return Ok(Attempt::Failed {
+                shrink: Some(0.5),
+                cap_growth: true,
+            });
+        };
+        let hd = h * D;
+        let ([k1, k2, k3], [f0, f1, f2]) = (&mut self.k, &mut self.f);
+        let (tder, ys, err) = (&self.tder, &mut self.ys, &mut self.err);
+        k1.copy_from(f0);
+        k1.axpy(hd, tder, 1.0);
+        let mut ok = w.solve_mut(k1);
+        ys.copy_from(y);
+        ys.axpy(0.5 * h, k1, 1.0);
+        ev.rhs(t + 0.5 * h, ys, f1)?;
+        k2.copy_from(f1);
+        *k2 -= &*k1;
+        ok &= w.solve_mut(k2);
+        *k2 += &*k1;
+        y_new.copy_from(y);
+        y_new.axpy(h, k2, 1.0);
+        ev.rhs(t_new, y_new, f2)?;
+        for i in 0..y.len() {
+            k3[i] = f2[i] - E32 * (k2[i] - f1[i]) - 2.0 * (k1[i] - f0[i]) + hd * tder[i];
+        }
+        ok &= w.solve_mut(k3);
+        for i in 0..y.len() {
+            err[i] = h / 6.0 * (k1[i] - 2.0 * k2[i] + k3[i]);
+        }
+        let en = weights.norm(err, y, y_new);
+        Ok(Attempt::checked(
+            en,
+            ok && all_finite(y_new) && all_finite(f2),
+        ))
+    }
+
+    fn interpolate(
+        &self,
+        theta: f64,
+        h: f64,
+        y: &DVector<f64>,
+        _y_new: &DVector<f64>,
+        out: &mut DVector<f64>,
+    ) {
+        let denom = 1.0 - 2.0 * D;
+        let a = theta * (1.0 - theta) / denom;
+        let b = theta * (theta - 2.0 * D) / denom;
+        let [k1, k2, _] = &self.k;
+        for i in 0..out.len() {
+            out[i] = y[i] + h * (a * k1[i] + b * k2[i]);
+        }
+    }
+
+    fn accept(&mut self) {
+        self.f.swap(0, 2);
+    }
 }
 
 #[cfg(test)]

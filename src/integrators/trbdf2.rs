@@ -21,19 +21,23 @@
 //! (`f_γ = (z_γ − y_n)/(d h) − f_n` etc.), so `f_{n+1}` serves as `f_n` of the next step.
 //! Dense output: cubic Hermite through `(y_n, f_n)`, `(y_{n+1}, f_{n+1})`.
 
-use super::control::{check_underflow, clamp_to_end, initial_step, max_step};
+use super::adaptive::{AdaptiveStepper, Attempt, Step, integrate};
+use super::control::Controller;
 use super::eval::Evaluator;
-use super::grid::Recorder;
-use super::lu::IterationMatrix;
-use super::method::{check_input, invalid};
-use super::newton::Newton;
+use super::newton::{IterationMatrix, Newton, iteration_matrix};
 use super::norm::{Weights, rms_norm};
 use super::rk23::hermite;
 use super::{OdeSystem, OutputGrid, Solution, SolverError, SolverOptions};
 use nalgebra::{DMatrix, DVector};
+use std::f64::consts::SQRT_2;
 
-const NAME: &str = "trbdf2";
 const NEWTON_MAXITER: usize = 5;
+/// `γ = 2 − √2`, `d = γ/2`, `w = √2/4`.
+const GAMMA: f64 = 2.0 - SQRT_2;
+const D: f64 = GAMMA / 2.0;
+const W: f64 = SQRT_2 / 4.0;
+/// Weights of the error estimate.
+const E: [f64; 3] = [(SQRT_2 - 1.0) / 3.0, -1.0 / 3.0, GAMMA / 3.0];
 
 /// Integrates with error control `opts.rtol`, `opts.atol`.
 pub fn solve<S: OdeSystem + ?Sized>(
@@ -42,137 +46,191 @@ pub fn solve<S: OdeSystem + ?Sized>(
     grid: &OutputGrid,
     opts: &SolverOptions,
 ) -> Result<Solution, SolverError> {
-    let (t0, t_end) = (grid.t0, grid.t_end());
-    check_input(sys, y0, opts).map_err(|m| invalid(NAME, t0, m))?;
-    let n = y0.len();
-    let weights = Weights::new(opts, n);
-    let s2 = 2f64.sqrt();
-    let gamma = 2.0 - s2;
-    let d = gamma / 2.0;
-    let w = s2 / 4.0;
-    let (e1, e2, e3) = ((s2 - 1.0) / 3.0, -1.0 / 3.0, gamma / 3.0);
-    let tol_ref = weights.reference_tol();
-    let kappa = (10.0 * f64::EPSILON / tol_ref).max(0.03f64.min(tol_ref.sqrt()));
-    let mut newton = Newton::new(n, NEWTON_MAXITER, kappa);
+    integrate::<TrBdf2, _>(sys, y0, grid, opts, None)
+}
 
-    let mut ev = Evaluator::new(sys, NAME, opts, t0);
-    let mut rec = Recorder::new(grid, y0);
-    let h_max = max_step(opts, t_end - t0);
-    let mut y = y0.clone();
-    let mut fn_ = DVector::zeros(n);
-    ev.rhs_finite(t0, &y, &mut fn_)?;
-    let mut h = initial_step(&mut ev, t0, &y, &fn_, 2, t_end - t0, opts)?;
-    let mut jac = DMatrix::zeros(n, n);
-    ev.jacobian(t0, &y, Some(&fn_), &mut jac)?;
-    let mut lu: Option<(f64, IterationMatrix)> = None;
+/// The Jacobian and its iteration matrix, Newton state, stages.
+struct TrBdf2 {
+    newton: Newton,
+    jac: DMatrix<f64>,
+    /// `W = I − d h J` for the `d h` it was factored with.
+    lu: Option<(f64, IterationMatrix)>,
+    /// `J` was evaluated at the start of the current step.
+    current_jac: bool,
+    /// Newton failed with an old `J`: re-evaluate it before the next attempt.
+    refresh_jac: bool,
+    /// Newton iterations of the last successful attempt (larger of the two stages).
+    iters: usize,
+    /// `f_n`, `z_γ`, `f_γ`, `f_{n+1}`, then scratch.
+    fn_: DVector<f64>,
+    zg: DVector<f64>,
+    fg: DVector<f64>,
+    f_new: DVector<f64>,
+    base: DVector<f64>,
+    scale: DVector<f64>,
+    est: DVector<f64>,
+}
 
-    let (mut zg, mut fg) = (DVector::zeros(n), DVector::zeros(n));
-    let (mut y_new, mut f_new) = (DVector::zeros(n), DVector::zeros(n));
-    let mut base = DVector::zeros(n);
-    let mut scale = DVector::zeros(n);
-    let mut est = DVector::zeros(n);
-    let mut t = t0;
-    let mut rejected_last = false;
-    loop {
-        ev.check_step_budget()?;
-        let mut current_jac = false;
-        let (t_new, h_step, last, en, iters) = loop {
-            check_underflow(&ev, t, h)?;
-            let (h_step, t_new, last) = clamp_to_end(t, h, t_end);
-            let dh = d * h_step;
-            if lu.as_ref().is_none_or(|(c, _)| *c != dh) {
-                ev.stats.lu_decompositions += 1;
-                lu = IterationMatrix::new(&jac, dh).map(|m| (dh, m));
-            }
-            weights.fill_scale(&mut scale, &y);
-            let mut ok = false;
-            let mut iters = 0;
-            if let Some((_, wm)) = lu.as_ref() {
-                // TR stage, predictor: explicit Euler
-                base.copy_from(&y);
-                base.axpy(dh, &fn_, 1.0);
-                zg.copy_from(&y);
-                zg.axpy(gamma * h_step, &fn_, 1.0);
-                let o1 =
-                    newton.solve(&mut ev, wm, t + gamma * h_step, &base, dh, &mut zg, &scale)?;
-                if o1.converged {
-                    for i in 0..n {
-                        fg[i] = (zg[i] - base[i]) / dh;
-                    }
-                    // BDF2 stage, predictor: quadratic through (y_n, f_n) and z_γ
-                    for i in 0..n {
-                        base[i] = y[i] + h_step * w * (fn_[i] + fg[i]);
-                        let c2 = (zg[i] - y[i] - gamma * h_step * fn_[i]) / (gamma * gamma);
-                        y_new[i] = y[i] + h_step * fn_[i] + c2;
-                    }
-                    let o2 = newton.solve(&mut ev, wm, t_new, &base, dh, &mut y_new, &scale)?;
-                    ok = o2.converged;
-                    iters = o1.iters.max(o2.iters);
-                }
-            }
-            if !ok {
-                ev.reject_step();
-                if !current_jac {
-                    ev.jacobian(t, &y, Some(&fn_), &mut jac)?;
-                    current_jac = true;
-                    lu = None;
-                } else {
-                    h = 0.5 * h_step;
-                    lu = None;
-                }
-                continue;
-            }
-            for i in 0..n {
-                f_new[i] = (y_new[i] - base[i]) / dh;
-                est[i] = h_step * (e1 * fn_[i] + e2 * fg[i] + e3 * f_new[i]);
-            }
-            weights.fill_scale2(&mut scale, &y, &y_new);
-            let raw = rms_norm(&est, &scale);
-            let filtered = lu.as_ref().is_some_and(|(_, wm)| wm.solve_mut(&mut est));
-            let en = if filtered {
-                rms_norm(&est, &scale).max(raw / 16.0)
-            } else {
-                f64::INFINITY
-            };
-            if !en.is_finite() || en > 1.0 {
-                ev.reject_step();
-                let fac = if en.is_finite() {
-                    (0.9 * en.powf(-1.0 / 3.0)).max(0.2)
-                } else {
-                    0.2
-                };
-                h = h_step * fac;
-                rejected_last = true;
-                continue;
-            }
-            break (t_new, h_step, last, en, iters);
-        };
-        rec.record(t, t_new, &y_new, |theta, out| {
-            hermite(theta, h_step, &y, &fn_, &y_new, &f_new, out)
-        });
-        ev.accept_step(t_new);
-        if last {
-            break;
+impl AdaptiveStepper for TrBdf2 {
+    const NAME: &'static str = "trbdf2";
+    const START_ORDER: u32 = 2;
+    const CONTROL: Controller = Controller {
+        exponent: 3.0,
+        safety: 0.9,
+        fac_min: 0.2,
+    };
+
+    fn new(n: usize, weights: &Weights) -> Self {
+        let tol_ref = weights.reference_tol();
+        let kappa = (10.0 * f64::EPSILON / tol_ref).max(0.03f64.min(tol_ref.sqrt()));
+        let z = || DVector::zeros(n);
+        Self {
+            newton: Newton::new(n, NEWTON_MAXITER, kappa),
+            jac: DMatrix::zeros(n, n),
+            lu: None,
+            current_jac: false,
+            refresh_jac: false,
+            iters: 0,
+            fn_: z(),
+            zg: z(),
+            fg: z(),
+            f_new: z(),
+            base: z(),
+            scale: z(),
+            est: z(),
         }
-        let safety = 0.9 * (2 * NEWTON_MAXITER + 1) as f64 / (2 * NEWTON_MAXITER + iters) as f64;
-        let fac_max = if rejected_last { 1.0 } else { 5.0 };
-        let fac = if en == 0.0 {
-            fac_max
-        } else {
-            (safety * en.powf(-1.0 / 3.0)).clamp(0.2, fac_max)
-        };
-        // keep the LU when the step would change by less than 20 %
-        if !(0.8..=1.2).contains(&fac) {
-            h = (h_step * fac).min(h_max);
-        } else {
-            h = h_step.min(h_max);
-        }
-        rejected_last = false;
-        t = t_new;
-        std::mem::swap(&mut y, &mut y_new);
-        std::mem::swap(&mut fn_, &mut f_new);
     }
-    Ok(rec.finish(ev.stats))
+
+    fn derivative_mut(&mut self) -> &mut DVector<f64> {
+        &mut self.fn_
+    }
+
+    /// The first Jacobian; later ones only when Newton fails.
+    fn start<S: OdeSystem + ?Sized>(
+        &mut self,
+        ev: &mut Evaluator<'_, S>,
+        t0: f64,
+        y0: &DVector<f64>,
+    ) -> Result<(), SolverError> {
+        ev.jacobian(t0, y0, Some(&self.fn_), &mut self.jac)
+    }
+
+    fn begin_step<S: OdeSystem + ?Sized>(
+        &mut self,
+        _ev: &mut Evaluator<'_, S>,
+        _t: f64,
+        _y: &DVector<f64>,
+    ) -> Result<(), SolverError> {
+        self.current_jac = false;
+        Ok(())
+    }
+
+    fn attempt<S: OdeSystem + ?Sized>(
+        &mut self,
+        ev: &mut Evaluator<'_, S>,
+        weights: &Weights,
+        step: &Step,
+        y: &DVector<f64>,
+        y_new: &mut DVector<f64>,
+    ) -> Result<Attempt, SolverError> {
+        let Step { t, h, t_new } = *step;
+        if self.refresh_jac {
+            ev.jacobian(t, y, Some(&self.fn_), &mut self.jac)?;
+            self.current_jac = true;
+            self.refresh_jac = false;
+        }
+        let n = y.len();
+        let dh = D * h;
+        if self.lu.as_ref().is_none_or(|(c, _)| *c != dh) {
+            ev.stats.lu_decompositions += 1;
+            self.lu = iteration_matrix(&self.jac, dh).map(|m| (dh, m));
+        }
+        let Self {
+            newton,
+            fn_,
+            zg,
+            fg,
+            base,
+            scale,
+            ..
+        } = self;
+        weights.fill_scale(scale, y);
+        let mut iters = None;
+        if let Some((_, wm)) = self.lu.as_ref() {
+            // TR stage, predictor: explicit Euler
+            base.copy_from(y);
+            base.axpy(dh, fn_, 1.0);
+            zg.copy_from(y);
+            zg.axpy(GAMMA * h, fn_, 1.0);
+            let o1 = newton.solve(ev, wm, t + GAMMA * h, base, dh, zg, scale)?;
+            if o1.converged {
+                for i in 0..n {
+                    fg[i] = (zg[i] - base[i]) / dh;
+                }
+                // BDF2 stage, predictor: quadratic through (y_n, f_n) and z_γ
+                for i in 0..n {
+                    base[i] = y[i] + h * W * (fn_[i] + fg[i]);
+                    let c2 = (zg[i] - y[i] - GAMMA * h * fn_[i]) / (GAMMA * GAMMA);
+                    y_new[i] = y[i] + h * fn_[i] + c2;
+                }
+                let o2 = newton.solve(ev, wm, t_new, base, dh, y_new, scale)?;
+                iters = o2.converged.then_some(o1.iters.max(o2.iters));
+            }
+        }
+        let Some(iters) = iters else {
+            self.lu = None;
+            // first failure of the step: retry it with a fresh Jacobian, then halve it
+            self.refresh_jac = !self.current_jac;
+            let shrink = self.current_jac.then_some(0.5);
+            return Ok(Attempt::Failed {
+                shrink,
+                cap_growth: false,
+            });
+        };
+        self.iters = iters;
+        for i in 0..n {
+            self.f_new[i] = (y_new[i] - self.base[i]) / dh;
+            self.est[i] = h * (E[0] * self.fn_[i] + E[1] * self.fg[i] + E[2] * self.f_new[i]);
+        }
+        let (est, scale) = (&mut self.est, &mut self.scale);
+        weights.fill_scale2(scale, y, y_new);
+        let raw = rms_norm(est, scale);
+        let filtered = self.lu.as_ref().is_some_and(|(_, wm)| wm.solve_mut(est));
+        let en = if filtered {
+            rms_norm(est, scale).max(raw / 16.0)
+        } else {
+            f64::INFINITY
+        };
+        Ok(Attempt::Estimated(en))
+    }
+
+    fn interpolate(
+        &self,
+        theta: f64,
+        h: f64,
+        y: &DVector<f64>,
+        y_new: &DVector<f64>,
+        out: &mut DVector<f64>,
+    ) {
+        hermite(theta, h, y, &self.fn_, y_new, &self.f_new, out)
+    }
+
+    fn accept(&mut self) {
+        std::mem::swap(&mut self.fn_, &mut self.f_new);
+    }
+
+    /// Safety factor lowered when Newton needed many iterations; the step is kept when the
+    /// factor is within 20 % of 1 (so the LU can be reused).
+    fn accept_factor(&self, err: f64, fac_max: f64) -> f64 {
+        let safety =
+            0.9 * (2 * NEWTON_MAXITER + 1) as f64 / (2 * NEWTON_MAXITER + self.iters) as f64;
+        let fac = Controller {
+            safety,
+            ..Self::CONTROL
+        }
+        .factor(err, fac_max);
+        if (0.8..=1.2).contains(&fac) { 1.0 } else { fac }
+    }
 }
 
 #[cfg(test)]

@@ -1,4 +1,6 @@
-//! Solves with, and rank diagnosis of, the fixed-size constraint Jacobian.
+//! The crate's one small dense LU: solves with, and rank diagnosis of, the fixed-size
+//! constraint Jacobian ([`Factorization`]) and the iteration matrices `I − c J` of the
+//! implicit integrators (`crate::integrators`, dynamic size: [`DenseLu<Dyn>`](DenseLu)).
 //!
 //! From nalgebra (stack-allocated for `SMatrix`, no heap): the
 //! factorisations [`LU`] (partial row pivoting, P A = L U) and [`FullPivLU`]
@@ -11,24 +13,34 @@
 //! the Gram–Schmidt search for the dependent row. nalgebra's LU needs
 //! `Const<N>: DimMin<Const<N>>`, i.e. N ≤ 127.
 
-use nalgebra::{Const, DMatrix, DimMin, FullPivLU, LU, SMatrix, SVector};
+use nalgebra::allocator::Allocator;
+use nalgebra::{Const, DMatrix, DefaultAllocator, DimMin, FullPivLU, LU, OMatrix, OVector};
 
-/// nalgebra's LU of an N×N matrix, partial or complete pivoting.
+/// nalgebra's LU of a square matrix of dimension `D` (`Const<N>` or `Dyn`), partial or
+/// complete pivoting.
 #[derive(Clone, Debug)]
-pub enum Factorization<const N: usize>
+pub enum DenseLu<D>
 where
-    Const<N>: DimMin<Const<N>, Output = Const<N>>,
+    D: DimMin<D, Output = D>,
+    DefaultAllocator: Allocator<D, D> + Allocator<D>,
 {
-    /// Partial pivoting (`SMatrix::lu`, P A = L U); its relative pivot is an
+    /// Partial pivoting (`lu()`, P A = L U); its relative pivot is an
     /// indicator only, rank decisions near singularity use complete pivoting.
-    Partial(LU<f64, Const<N>, Const<N>>),
-    /// Complete pivoting (`SMatrix::full_piv_lu`, P A Q = L U), rank-revealing.
-    Full(FullPivLU<f64, Const<N>, Const<N>>),
+    Partial(LU<f64, D, D>),
+    /// Complete pivoting (`full_piv_lu()`, P A Q = L U), rank-revealing.
+    Full(FullPivLU<f64, D, D>),
 }
+
+/// The LU of the N×N constraint Jacobian (stack-allocated).
+pub type Factorization<const N: usize> = DenseLu<Const<N>>;
 
 /// min |u_kk| / max |u_kk| over the diagonal of `u` (only the diagonal is
 /// read); 0 when a pivot is zero or not finite.
-fn pivot_ratio<const N: usize>(u: &SMatrix<f64, N, N>) -> f64 {
+fn pivot_ratio<D>(u: &OMatrix<f64, D, D>) -> f64
+where
+    D: DimMin<D, Output = D>,
+    DefaultAllocator: Allocator<D, D> + Allocator<D>,
+{
     let d = u.diagonal().abs();
     if d.iter().all(|v| v.is_finite()) && d.min() > 0.0 {
         d.min() / d.max()
@@ -37,18 +49,19 @@ fn pivot_ratio<const N: usize>(u: &SMatrix<f64, N, N>) -> f64 {
     }
 }
 
-impl<const N: usize> Factorization<N>
+impl<D> DenseLu<D>
 where
-    Const<N>: DimMin<Const<N>, Output = Const<N>>,
+    D: DimMin<D, Output = D>,
+    DefaultAllocator: Allocator<D, D> + Allocator<D>,
 {
     /// The packed factors (L below, U on and above the diagonal) via
     /// nalgebra's `lu_internal()`, which is public but `#[doc(hidden)]`: the
     /// documented `u()` and `unpack()` copy U, at about half the cost of the
     /// LU itself, once per Newton iterate.
-    fn packed(&self) -> &SMatrix<f64, N, N> {
+    fn packed(&self) -> &OMatrix<f64, D, D> {
         match self {
-            Factorization::Partial(f) => f.lu_internal(),
-            Factorization::Full(f) => f.lu_internal(),
+            DenseLu::Partial(f) => f.lu_internal(),
+            DenseLu::Full(f) => f.lu_internal(),
         }
     }
 
@@ -57,14 +70,32 @@ where
         pivot_ratio(self.packed())
     }
 
+    /// nalgebra's `is_invertible`: no pivot is exactly zero.
+    pub fn is_invertible(&self) -> bool {
+        match self {
+            DenseLu::Partial(f) => f.is_invertible(),
+            DenseLu::Full(f) => f.is_invertible(),
+        }
+    }
+
+    /// nalgebra's `solve_mut`: `false` (and `x` garbage) when A is exactly singular.
+    fn solve_in_place(&self, x: &mut OVector<f64, D>) -> bool {
+        match self {
+            DenseLu::Partial(f) => f.solve_mut(x),
+            DenseLu::Full(f) => f.solve_mut(x),
+        }
+    }
+
+    /// Solve A x = b in place (nalgebra's `solve_mut`); `false` when A is exactly singular
+    /// or the result is not finite.
+    pub fn solve_mut(&self, b: &mut OVector<f64, D>) -> bool {
+        self.solve_in_place(b) && b.iter().all(|v| v.is_finite())
+    }
+
     /// Solve A x = b (nalgebra's `solve_mut`); NaN when A is exactly singular.
-    pub fn solve(&self, b: &SVector<f64, N>) -> SVector<f64, N> {
-        let mut x = *b;
-        let ok = match self {
-            Factorization::Partial(f) => f.solve_mut(&mut x),
-            Factorization::Full(f) => f.solve_mut(&mut x),
-        };
-        if !ok {
+    pub fn solve(&self, b: &OVector<f64, D>) -> OVector<f64, D> {
+        let mut x = b.clone();
+        if !self.solve_in_place(&mut x) {
             x.fill(f64::NAN);
         }
         x
@@ -73,11 +104,11 @@ where
     /// Solve Aᵀ x = b, which nalgebra's LU does not offer: with P A Q = L U
     /// (Q = I for partial pivoting), x = Pᵀ L⁻ᵀ U⁻ᵀ Qᵀ b by nalgebra's
     /// transposed triangular solves; NaN when A is exactly singular.
-    pub fn solve_transpose(&self, b: &SVector<f64, N>) -> SVector<f64, N> {
-        let mut x = *b;
+    pub fn solve_transpose(&self, b: &OVector<f64, D>) -> OVector<f64, D> {
+        let mut x = b.clone();
         let (p, l) = match self {
-            Factorization::Partial(f) => (f.p(), f.l()),
-            Factorization::Full(f) => {
+            DenseLu::Partial(f) => (f.p(), f.l()),
+            DenseLu::Full(f) => {
                 f.q().permute_rows(&mut x);
                 (f.p(), f.l())
             }
@@ -127,7 +158,7 @@ pub fn most_dependent_row(rows: &DMatrix<f64>) -> (usize, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::{Matrix4, Vector4};
+    use nalgebra::{DVector, Matrix4, Vector4};
 
     fn sample() -> Matrix4<f64> {
         Matrix4::new(
@@ -170,5 +201,23 @@ mod tests {
         nan[(1, 1)] = f64::NAN;
         assert_eq!(Factorization::Full(nan.full_piv_lu()).pivot_ratio(), 0.0);
         assert_eq!(Factorization::Partial(nan.lu()).pivot_ratio(), 0.0);
+    }
+
+    #[test]
+    fn dynamic_size_solves_and_reports_singular_or_non_finite() {
+        let a = DMatrix::from_column_slice(4, 4, sample().as_slice());
+        let b = DVector::from_vec(vec![1.0, -2.0, 0.5, 3.0]);
+        let lu = DenseLu::Partial(a.clone().lu());
+        let mut x = b.clone();
+        assert!(lu.is_invertible() && lu.solve_mut(&mut x));
+        assert!((&a * &x - &b).norm() < 1e-13);
+        assert!((a.transpose() * lu.solve_transpose(&b) - &b).norm() < 1e-13);
+        let zero = DenseLu::Partial(DMatrix::<f64>::zeros(3, 3).lu());
+        assert!(!zero.is_invertible());
+        assert!(!zero.solve_mut(&mut DVector::from_element(3, 1.0)));
+        // invertible, but the solution overflows
+        let tiny = DenseLu::Partial(DMatrix::from_diagonal_element(2, 2, 1e-300).lu());
+        assert!(tiny.is_invertible());
+        assert!(!tiny.solve_mut(&mut DVector::from_element(2, 1e300)));
     }
 }
