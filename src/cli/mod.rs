@@ -5,12 +5,15 @@
 
 mod bench;
 mod check;
+mod cycle;
 mod dynamics;
 mod fem;
 mod integrators;
 mod mass;
+mod merge;
 mod pipeline;
 mod study;
+mod sweep;
 
 use clap::{Parser, Subcommand};
 
@@ -35,10 +38,15 @@ enum Command {
     Dynamics(dynamics::DynamicsCommand),
     /// Stage 3: tet10 FEM of one design under F_x and F_y (the design's peak pin force).
     Fem(fem::FemArgs),
+    /// Stress over one crank revolution (inertia relief, superposition) and the fatigue safety
+    /// factor, on stage 3's mesh.
+    Cycle(cycle::CycleArgs),
     /// Work–precision comparison of the integrators on the free run (thesis ch. 4).
     Integrators(integrators::IntegratorsArgs),
     /// Run every stage that exists on every design of a folder and write the reports.
     Study(study::StudyArgs),
+    /// Merge the shards of a split study (`study --shard K/N`) into the one-machine reports.
+    Merge(merge::MergeArgs),
     /// Compare the latest study results with the committed baseline (the CI regression gate).
     Check(check::CheckArgs),
     /// Benchmarks, reported as ratios against a reference run in the same process.
@@ -48,6 +56,9 @@ enum Command {
     Setup,
     /// Run a script of `pipeline/` with the project's Python environment.
     Pipeline(pipeline::PipelineArgs),
+    /// Parameter sweeps: generate rods from a Latin-hypercube sample of the design parameters.
+    #[command(subcommand)]
+    Sweep(sweep::SweepCommand),
 }
 
 /// Parses the command line, runs the command, prints errors; returns the exit status.
@@ -63,12 +74,15 @@ pub fn main() -> i32 {
         Command::Mass(args) => mass::run(args),
         Command::Dynamics(command) => dynamics::run(command),
         Command::Fem(args) => fem::run(args),
+        Command::Cycle(args) => cycle::run(args),
         Command::Integrators(args) => integrators::run(args),
         Command::Study(args) => study::run(args),
+        Command::Merge(args) => merge::run(args),
         Command::Check(args) => check::run(args),
         Command::Bench(command) => bench::run(command),
         Command::Setup => pipeline::setup(),
         Command::Pipeline(args) => pipeline::run(args),
+        Command::Sweep(command) => sweep::run(command),
     };
     match result {
         Ok(code) => code,

@@ -31,6 +31,9 @@ pub struct StudyArgs {
     /// Leave out the FEM stage (mass and pin force only; no Python, no mesh).
     #[arg(long)]
     skip_fem: bool,
+    /// Compute only shard K of N of the designs (a stable split by design id), for `merge`.
+    #[arg(long, value_name = "K/N")]
+    shard: Option<crate::study::shard::Shard>,
     /// Recompute every design even when its cached results are current.
     #[arg(long)]
     no_cache: bool,
@@ -48,9 +51,13 @@ pub fn run(args: StudyArgs) -> Result<i32> {
         jobs: args.jobs,
         use_cache: !args.no_cache,
         skip_fem: args.skip_fem,
+        shard: args.shard,
     };
     let count = crate::geometry::design::find_stl_files(std::slice::from_ref(&args.designs))
-        .map(|f| f.len())
+        .map(|f| match args.shard {
+            Some(sh) => crate::study::shard::share(&f, sh).len(),
+            None => f.len(),
+        })
         .unwrap_or(0);
     // A bar for people at a terminal; plain lines (kept in CI logs) otherwise.
     let bar = std::io::stderr().is_terminal().then(|| {

@@ -26,6 +26,16 @@
 //! yield_mpa = 355.0
 //! safety_factor = 1.5
 //! with_error = false  # judge the peak plus its estimated error instead of the peak
+//! fatigue = true      # the criterion includes the cycle's fatigue safety factor …
+//! fatigue_safety_factor = 1.5   # … which must be at least this
+//!
+//! [cycle]             # stress over one revolution (inertia relief, fatigue)
+//! enabled = true
+//! instants = 360      # equally spaced, the first at crank angle 0
+//!
+//! [material]          # fatigue strengths (S355: EN 10025-2 minimum tensile strength; Shigley's
+//! ultimate_mpa = 470.0          # S'e = 0.5 Sut for steels, no Marin factors)
+//! endurance_mpa = 235.0
 //! ```
 
 use anyhow::{Context, Result, bail};
@@ -113,6 +123,10 @@ pub struct CriterionConfig {
     pub safety_factor: f64,
     /// Judge the peak plus its estimated error (the upper end of the error bar) instead of the peak.
     pub with_error: bool,
+    /// Include the cycle stage's fatigue safety factor in the criterion (when the stage runs).
+    pub fatigue: bool,
+    /// The smallest accepted Goodman safety factor.
+    pub fatigue_safety_factor: f64,
 }
 
 impl Default for CriterionConfig {
@@ -121,6 +135,49 @@ impl Default for CriterionConfig {
             yield_mpa: 355.0,
             safety_factor: 1.5,
             with_error: false,
+            fatigue: true,
+            fatigue_safety_factor: 1.5,
+        }
+    }
+}
+
+/// The cycle stage: stress over one revolution.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CycleConfig {
+    /// Run the stage in the study.
+    pub enabled: bool,
+    /// Instants over the revolution (≥ 360), the first at crank angle 0.
+    pub instants: usize,
+}
+
+impl Default for CycleConfig {
+    fn default() -> Self {
+        CycleConfig {
+            enabled: true,
+            instants: 360,
+        }
+    }
+}
+
+/// Fatigue strengths of the rod's material.
+///
+/// Defaults: S355 structural steel, minimum tensile strength 470 MPa (EN 10025-2, 3–100 mm);
+/// endurance limit of the polished rotating-beam specimen S'e = 0.5 Sut (Budynas–Nisbett,
+/// *Shigley's Mechanical Engineering Design*, 10th ed., eq. 6-8), without Marin factors (surface,
+/// size, reliability: set `endurance_mpa` to the corrected value for a real part).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct MaterialConfig {
+    pub ultimate_mpa: f64,
+    pub endurance_mpa: f64,
+}
+
+impl Default for MaterialConfig {
+    fn default() -> Self {
+        MaterialConfig {
+            ultimate_mpa: 470.0,
+            endurance_mpa: 235.0,
         }
     }
 }
@@ -132,6 +189,8 @@ pub struct StudyConfig {
     pub driven: DrivenConfig,
     pub fem: FemConfig,
     pub criterion: CriterionConfig,
+    pub cycle: CycleConfig,
+    pub material: MaterialConfig,
 }
 
 impl StudyConfig {
@@ -169,6 +228,12 @@ impl StudyConfig {
             ("fem.youngs_modulus_pa", self.fem.youngs_modulus_pa),
             ("criterion.yield_mpa", self.criterion.yield_mpa),
             ("criterion.safety_factor", self.criterion.safety_factor),
+            (
+                "criterion.fatigue_safety_factor",
+                self.criterion.fatigue_safety_factor,
+            ),
+            ("material.ultimate_mpa", self.material.ultimate_mpa),
+            ("material.endurance_mpa", self.material.endurance_mpa),
         ];
         for (key, v) in positive {
             if !(v.is_finite() && v > 0.0) {
@@ -181,6 +246,15 @@ impl StudyConfig {
         }
         if self.fem.max_iterations == 0 || self.fem.max_dofs < 1000 {
             bail!("`fem.max_iterations` must be at least 1 and `fem.max_dofs` at least 1000");
+        }
+        if self.cycle.instants < 360 {
+            bail!(
+                "`cycle.instants` must be at least 360, got {}",
+                self.cycle.instants
+            );
+        }
+        if self.material.endurance_mpa >= self.material.ultimate_mpa {
+            bail!("`material.endurance_mpa` must be below `material.ultimate_mpa`");
         }
         if self.driven.steps == 0 {
             bail!("`driven.steps` must be at least 1");

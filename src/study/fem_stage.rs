@@ -108,6 +108,31 @@ pub struct StressVerdict {
     /// displacement above 1 % of the centre distance); empty when it is not.
     #[serde(default)]
     pub model_validity: Vec<String>,
+    /// The static verdict alone (`pass` also includes fatigue when it is judged).
+    #[serde(default)]
+    pub static_pass: bool,
+    /// The cycle's Goodman safety factor and the smallest accepted, when fatigue is judged.
+    #[serde(default)]
+    pub fatigue_safety_factor: Option<f64>,
+    #[serde(default)]
+    pub fatigue_required: Option<f64>,
+}
+
+/// Adds the cycle's fatigue safety factor to the verdict when the configuration judges fatigue:
+/// the design passes when it passes statically and its Goodman factor is at least
+/// `criterion.fatigue_safety_factor`.
+pub fn judge_fatigue(
+    verdict: &mut StressVerdict,
+    cycle: &super::cycle_stage::DesignCycle,
+    config: &StudyConfig,
+) {
+    if !config.criterion.fatigue {
+        return;
+    }
+    let required = config.criterion.fatigue_safety_factor;
+    verdict.fatigue_safety_factor = Some(cycle.fatigue_safety_factor);
+    verdict.fatigue_required = Some(required);
+    verdict.pass = verdict.static_pass && cycle.fatigue_safety_factor >= required;
 }
 
 /// The stage-3 record of one design.
@@ -226,6 +251,30 @@ pub fn fem_of_design(
     vtu_dir: &Path,
     mode: &MeshMode,
 ) -> Result<DesignFem> {
+    Ok(fem_of_design_with_mesh(stl, force_n, config, work_dir, vtu_dir, mode)?.0)
+}
+
+/// The mesh stage 3 ended on, in the rod frame (m), with what a later stage on the same mesh
+/// needs.
+#[derive(Clone, Debug)]
+pub struct StageMesh {
+    pub mesh: TetMesh,
+    pub bores: BoreSpec,
+    /// Sharp re-entrant edges (m) and the bands left out of judged maxima (m).
+    pub singular_edges_m: Vec<[[f64; 3]; 2]>,
+    pub fixed_band_m: f64,
+    pub singular_band_m: f64,
+}
+
+/// [`fem_of_design`], also returning the final mesh.
+pub fn fem_of_design_with_mesh(
+    stl: &Path,
+    force_n: f64,
+    config: &StudyConfig,
+    work_dir: &Path,
+    vtu_dir: &Path,
+    mode: &MeshMode,
+) -> Result<(DesignFem, StageMesh)> {
     let context = || format!("{}: FEM", stl.display());
     let python = python().with_context(context)?;
     let script = pipeline_script(MESHER);
@@ -244,7 +293,7 @@ pub fn fem_of_design(
         vtu_dir: Some(vtu_dir.to_path_buf()),
         vtu_stem: Some("fem".into()),
         fixed_band_m: Some(config.fem.fixed_band_mm * 1e-3),
-        singular_edges_m: singular_edges,
+        singular_edges_m: singular_edges.clone(),
         singular_band_m: Some(config.fem.singular_band_mm * 1e-3),
         ..RodOptions::default()
     };
@@ -265,7 +314,7 @@ pub fn fem_of_design(
             dir,
         )
     };
-    let (fem, summary) = match mode {
+    let (fem, summary, mesh) = match mode {
         MeshMode::User(file) => {
             let start = std::time::Instant::now();
             let out = work_dir.join("user.rodmesh");
@@ -294,7 +343,7 @@ pub fn fem_of_design(
                 adaptive: None,
                 surface_triangles: [surface.triangles_export, surface.triangles.len()],
             };
-            (fem, summary)
+            (fem, summary, mesh)
         }
         MeshMode::Fixed(size_mm) => {
             let meshed =
@@ -314,7 +363,7 @@ pub fn fem_of_design(
                 adaptive: None,
                 surface_triangles: [surface.triangles_export, surface.triangles.len()],
             };
-            (fem, summary)
+            (fem, summary, meshed.mesh)
         }
         MeshMode::Adaptive => {
             let facets = FacetScale::new(
@@ -400,16 +449,25 @@ pub fn fem_of_design(
                 }),
                 surface_triangles: [surface.triangles_export, surface.triangles.len()],
             };
-            (out.solution.result, summary)
+            (out.solution.result, summary, out.mesh)
         }
     };
     let criterion = verdict(&fem, config, surface.centre_distance_mm);
-    Ok(DesignFem {
-        force_n,
-        mesh: summary,
-        fem,
-        criterion,
-    })
+    Ok((
+        DesignFem {
+            force_n,
+            mesh: summary,
+            fem,
+            criterion,
+        },
+        StageMesh {
+            mesh,
+            bores,
+            singular_edges_m: singular_edges,
+            fixed_band_m: config.fem.fixed_band_mm * 1e-3,
+            singular_band_m: config.fem.singular_band_mm * 1e-3,
+        },
+    ))
 }
 
 /// Displacements above this fraction of the centre distance are beyond small-displacement
@@ -470,5 +528,8 @@ pub fn verdict(fem: &FemResult, config: &StudyConfig, centre_distance_mm: f64) -
             .max(fem.fy.max_von_mises_unaveraged_mpa),
         safety_factor: config.criterion.yield_mpa / governing,
         pass: governing <= allowed,
+        static_pass: governing <= allowed,
+        fatigue_safety_factor: None,
+        fatigue_required: None,
     }
 }

@@ -91,6 +91,19 @@ pub fn index_html(results: &StudyResults, out: &Path) -> String {
             "Peak pin force per design, in ranking order",
         );
     }
+    if !results.designs.is_empty() {
+        let _ = write!(
+            s,
+            "<h2>Pareto front</h2>\n<p>Designs not dominated on {}; marked in the ranking's last column (<a href=\"pareto.md\">pareto.md</a>, <a href=\"pareto.csv\">pareto.csv</a>).</p>\n",
+            escape(super::pareto::objectives(results))
+        );
+        image(
+            &mut s,
+            out,
+            "pareto.svg",
+            "mass against peak pin force; filled: on the Pareto front",
+        );
+    }
     for r in &rows {
         design_section(&mut s, r, out);
     }
@@ -216,6 +229,34 @@ fn design_section(s: &mut String, r: &RankRow, out: &Path) {
             ),
         ));
     }
+    if let Some(c) = r.cycle {
+        props.push((
+            "cycle (one revolution, inertia relief)",
+            format!(
+                "max von Mises {:.2} MPa at φ = {:.0}°, at ({:.1}, {:.1}, {:.1}) mm; reaction at B equals the dynamics' F_B to {:.1e} of the peak pin force",
+                c.max_von_mises_over_cycle_mpa,
+                c.crank_angle_of_max_deg,
+                c.location_of_max_mm[0],
+                c.location_of_max_mm[1],
+                c.location_of_max_mm[2],
+                c.reaction_mismatch_rel
+            ),
+        ));
+        props.push((
+            "fatigue (Goodman, signed von Mises)",
+            format!(
+                "safety factor {:.2} at ({:.1}, {:.1}, {:.1}) mm: σa {:.2} MPa, σm {:.2} MPa against Se {:.0} / Sut {:.0} MPa",
+                c.fatigue_safety_factor,
+                c.fatigue_location_mm[0],
+                c.fatigue_location_mm[1],
+                c.fatigue_location_mm[2],
+                c.fatigue_alternating_mpa,
+                c.fatigue_mean_mpa,
+                c.endurance_mpa,
+                c.ultimate_mpa
+            ),
+        ));
+    }
     s.push_str("<table class=\"props\">\n");
     for (k, v) in props {
         let _ = writeln!(s, "<tr><td>{}</td><td>{}</td></tr>", escape(k), escape(&v));
@@ -247,10 +288,32 @@ fn design_section(s: &mut String, r: &RankRow, out: &Path) {
             );
         }
     }
+    if r.cycle.is_some() {
+        image(
+            s,
+            out,
+            &format!("{dir}/von_mises_cycle.svg"),
+            "max von Mises over one revolution at every point (quasi-static, inertia relief); the marked point is the judged maximum",
+        );
+        image(
+            s,
+            out,
+            &format!("{dir}/cycle.svg"),
+            "the judged max von Mises at each crank angle",
+        );
+    }
     let links: Vec<String> = [
         ("pin_force.csv", "pin-force history (CSV)"),
+        (
+            "cycle.csv",
+            "stress and reactions over the revolution (CSV)",
+        ),
         ("fem_fx.vtu", "F_x field (ParaView)"),
         ("fem_fy.vtu", "F_y field (ParaView)"),
+        (
+            "cycle.vtu",
+            "max over the cycle and fatigue factor (ParaView)",
+        ),
     ]
     .iter()
     .filter_map(|(f, t)| link(out, &format!("{dir}/{f}"), t))

@@ -8,11 +8,15 @@ pub mod atomic_write;
 pub mod baseline;
 pub mod cache;
 pub mod config;
+pub mod cycle_stage;
 pub mod dynamics_stage;
 pub mod fem_stage;
 pub mod index_page;
+pub mod merge;
+pub mod pareto;
 pub mod plots;
 pub mod ranking;
+pub mod shard;
 pub mod tables;
 
 use crate::geometry::design::{DesignMass, find_stl_files, mass_of_design};
@@ -21,14 +25,15 @@ use anyhow::{Context, Result, bail};
 use atomic_write::write_atomic;
 use cache::{Cache, design_key};
 use config::StudyConfig;
+use cycle_stage::{DesignCycle, cycle_of_design};
 use dynamics_stage::{DesignDynamics, dynamics_of_design, write_history_csv};
-use fem_stage::{DesignFem, MeshMode, fem_of_design};
+use fem_stage::{DesignFem, MeshMode, fem_of_design_with_mesh};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
 /// The stages a study runs, in order, for the report's `stages_run`.
-pub const STAGES: &[&str] = &["mass", "dynamics driven", "fem"];
+pub const STAGES: &[&str] = &["mass", "dynamics driven", "fem", "cycle"];
 
 /// Everything the study found, as written to `results.json`.
 #[derive(Debug, Clone, Serialize)]
@@ -41,6 +46,10 @@ pub struct StudyResults {
     pub stages_skipped: Vec<String>,
     pub designs: Vec<DesignResult>,
     pub failed: Vec<FailedDesign>,
+    /// For a shard of a split study (`study --shard K/N`): which, and the designs of the folder;
+    /// absent from a whole or merged study.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shard: Option<shard::ShardRecord>,
 }
 
 /// The figures of one design that went through every stage.
@@ -50,6 +59,9 @@ pub struct DesignResult {
     pub dynamics: DesignDynamics,
     /// Stage 3, unless skipped.
     pub fem: Option<DesignFem>,
+    /// The cycle stage (stress over one revolution, fatigue), unless skipped.
+    #[serde(default)]
+    pub cycle: Option<DesignCycle>,
     /// The pin-force history (written to its own CSV, not to `results.json`).
     #[serde(skip)]
     pub history: DrivenResult,
@@ -102,6 +114,8 @@ pub struct StudyOptions<'a> {
     pub use_cache: bool,
     /// Leave out the FEM stage (a force-only study needs no mesh).
     pub skip_fem: bool,
+    /// Compute only this share of the designs.
+    pub shard: Option<shard::Shard>,
 }
 
 /// What happened to one design, reported as soon as it is done (for progress output).
@@ -117,6 +131,7 @@ struct CachedDesign {
     mass: DesignMass,
     dynamics: DesignDynamics,
     fem: Option<DesignFem>,
+    cycle: Option<DesignCycle>,
 }
 
 /// Runs the stages on every `*.stl` of `options.designs`, designs in parallel, calling
@@ -129,7 +144,23 @@ pub fn run_study(
     if !designs.is_dir() {
         bail!("{}: the designs folder does not exist", designs.display());
     }
-    let files = find_stl_files(&[designs.to_path_buf()])?;
+    let all_files = find_stl_files(&[designs.to_path_buf()])?;
+    let (files, shard_record) = match options.shard {
+        None => (all_files, None),
+        Some(sh) => {
+            let mine = shard::share(&all_files, sh);
+            let mut all: Vec<String> = all_files.iter().map(|f| shard::id_of(f)).collect();
+            all.sort();
+            let mut designs: Vec<String> = mine.iter().map(|f| shard::id_of(f)).collect();
+            designs.sort();
+            let record = shard::ShardRecord {
+                shard: sh,
+                all_designs: all,
+                designs,
+            };
+            (mine, Some(record))
+        }
+    };
     let cache = Cache::new(options.out);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(options.jobs)
@@ -149,21 +180,27 @@ pub fn run_study(
             })
             .collect()
     });
+    // the cycle runs on stage 3's mesh: skipped with it, or on its own by the configuration
+    let skipped = |s: &str| {
+        (options.skip_fem && (s == "fem" || s == "cycle"))
+            || (s == "cycle" && !options.config.cycle.enabled)
+    };
     let mut results = StudyResults {
         program_version: env!("CARGO_PKG_VERSION").into(),
         config: options.config,
         stages_run: STAGES
             .iter()
-            .filter(|s| !(options.skip_fem && **s == "fem"))
+            .filter(|s| !skipped(s))
             .map(|s| s.to_string())
             .collect(),
         stages_skipped: STAGES
             .iter()
-            .filter(|s| options.skip_fem && **s == "fem")
+            .filter(|s| skipped(s))
             .map(|s| s.to_string())
             .collect(),
         designs: Vec::new(),
         failed: Vec::new(),
+        shard: shard_record,
     };
     for outcome in outcomes {
         match outcome {
@@ -196,20 +233,24 @@ fn study_one(
     let scene = config.driven_scene();
     // the per-design files stage 3 writes beside its figures: a cached entry without them is
     // recomputed
-    let files_present = |fem: &Option<DesignFem>| {
-        fem.is_none()
-            || [
+    let present = |files: &[&str]| {
+        files
+            .iter()
+            .all(|f| options.out.join(file_safe(&id)).join(f).is_file())
+    };
+    let files_present = |hit: &CachedDesign| {
+        (hit.fem.is_none()
+            || present(&[
                 "von_mises_fx.svg",
                 "von_mises_fy.svg",
                 "fem_fx.vtu",
                 "fem_fy.vtu",
-            ]
-            .iter()
-            .all(|f| options.out.join(file_safe(&id)).join(f).is_file())
+            ]))
+            && (hit.cycle.is_none() || present(&["von_mises_cycle.svg", "cycle.vtu"]))
     };
     if let (Some(cache), Some(key)) = (cache, &key)
         && let Some(hit) = cache.get::<CachedDesign>(&id, key)
-        && files_present(&hit.fem)
+        && files_present(&hit)
     {
         let params = dynamics_stage::mechanism_for(&hit.mass, config.driven.gravity);
         let rod = dynamics_stage::rod_inertia(&hit.mass);
@@ -220,6 +261,7 @@ fn study_one(
                 mass: hit.mass,
                 dynamics: hit.dynamics,
                 fem: hit.fem,
+                cycle: hit.cycle,
                 history,
             };
             return (Ok(result), true);
@@ -239,24 +281,32 @@ fn study_one(
         failed.dynamics = Some(dynamics.clone());
         failed.history = Some(history.clone());
         failed.stage = STAGES[2].into();
-        let fem = if options.skip_fem {
-            None
-        } else {
+        let (mut fem, mut cycle) = (None, None);
+        if !options.skip_fem {
             let work = options.out.join(".cache").join("mesh").join(&id);
-            let vtu = options.out.join(file_safe(&id));
-            Some(fem_of_design(
+            let dir = options.out.join(file_safe(&id));
+            let (f, mesh) = fem_of_design_with_mesh(
                 stl,
                 dynamics.peak_pin_force_n,
                 config,
                 &work,
-                &vtu,
+                &dir,
                 &MeshMode::from_config(config),
-            )?)
-        };
+            )?;
+            let mut f = f;
+            if config.cycle.enabled {
+                failed.stage = STAGES[3].into();
+                let (c, _, _) = cycle_of_design(&mass, &mesh, config, Some(&dir))?;
+                fem_stage::judge_fatigue(&mut f.criterion, &c, config);
+                cycle = Some(c);
+            }
+            fem = Some(f);
+        }
         anyhow::Ok(DesignResult {
             mass,
             dynamics,
             fem,
+            cycle,
             history,
         })
     })();
@@ -265,6 +315,7 @@ fn study_one(
             mass: d.mass.clone(),
             dynamics: d.dynamics.clone(),
             fem: d.fem.clone(),
+            cycle: d.cycle.clone(),
         };
         // A cache that cannot be written only costs time on the next run.
         let _ = cache.put(&id, key, &entry);
@@ -279,7 +330,13 @@ fn study_one(
 }
 
 /// The keys of the stage-3 record that hold wall times or memory: they vary from run to run.
-const WALL_TIME_KEYS: [&str; 4] = ["seconds", "total_s", "timings", "peak_memory_mb"];
+const WALL_TIME_KEYS: [&str; 5] = [
+    "seconds",
+    "analysis_seconds",
+    "total_s",
+    "timings",
+    "peak_memory_mb",
+];
 
 /// Removes the wall-time keys from a JSON value, at every depth.
 fn strip_wall_times(v: &mut serde_json::Value) {
@@ -310,8 +367,10 @@ pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>>
     let mut stable = full;
     if let Some(designs) = stable.get_mut("designs").and_then(|d| d.as_array_mut()) {
         for d in designs {
-            if let Some(fem) = d.get_mut("fem") {
-                strip_wall_times(fem);
+            for stage in ["fem", "cycle"] {
+                if let Some(v) = d.get_mut(stage) {
+                    strip_wall_times(v);
+                }
             }
         }
     }
@@ -337,6 +396,64 @@ pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>>
         write_atomic(&plot, design_pin_force_plot(design, h)?.as_bytes())?;
         written.extend([path, plot]);
     }
+    for d in &results.designs {
+        if let Some(c) = &d.cycle {
+            let dir = out.join(file_safe(&d.mass.id));
+            let mut w = csv::Writer::from_writer(Vec::new());
+            w.write_record([
+                "crank_angle_deg",
+                "time_s",
+                "max_von_mises_away_from_fixed_mpa",
+                "reaction_b_x_n",
+                "reaction_b_y_n",
+                "reaction_b_z_n",
+                "dynamics_f_b_x_n",
+                "dynamics_f_b_y_n",
+            ])?;
+            for h in &c.history {
+                w.write_record(
+                    [
+                        h.crank_angle_deg,
+                        h.time_s,
+                        h.max_von_mises_away_from_fixed_mpa,
+                        h.reaction_b_n[0],
+                        h.reaction_b_n[1],
+                        h.reaction_b_n[2],
+                        h.dynamics_f_b_n[0],
+                        h.dynamics_f_b_n[1],
+                    ]
+                    .map(|v| format!("{v:e}")),
+                )?;
+            }
+            let path = dir.join("cycle.csv");
+            write_atomic(&path, &w.into_inner()?)?;
+            let plot = dir.join("cycle.svg");
+            let series = vec![plots::Series {
+                name: "max von Mises".into(),
+                points: c
+                    .history
+                    .iter()
+                    .map(|h| (h.crank_angle_deg, h.max_von_mises_away_from_fixed_mpa))
+                    .collect(),
+            }];
+            write_atomic(
+                &plot,
+                plots::line_chart(
+                    &format!(
+                        "{}: max von Mises over one revolution (inertia relief)",
+                        d.mass.design
+                    ),
+                    "crank angle φ [°] (0 = top dead centre)",
+                    "max von Mises away from the fixed bore [MPa]",
+                    &series,
+                    plots::Scale::Linear,
+                    plots::Scale::Linear,
+                )?
+                .as_bytes(),
+            )?;
+            written.extend([path, plot]);
+        }
+    }
     if !histories.is_empty() {
         let pin = out.join("pin_force.svg");
         write_atomic(&pin, pin_force_plot(&histories)?.as_bytes())?;
@@ -355,6 +472,39 @@ pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>>
             .as_bytes(),
         )?;
         written.extend([pin, bars]);
+    }
+    if !results.designs.is_empty() {
+        let md = out.join("pareto.md");
+        write_atomic(&md, pareto::markdown(results).as_bytes())?;
+        let csv_path = out.join("pareto.csv");
+        write_atomic(&csv_path, &pareto::csv(results)?)?;
+        let svg = out.join("pareto.svg");
+        let points: Vec<plots::LabelledPoint> = pareto::pareto(results)
+            .into_iter()
+            .map(|r| plots::LabelledPoint {
+                label: format!(
+                    " {}{}",
+                    r.id,
+                    r.safety_factor
+                        .map_or(String::new(), |s| format!(" (SF {s:.2})"))
+                ),
+                x: r.mass_kg,
+                y: r.peak_pin_force_n,
+                highlight: r.on_front,
+            })
+            .collect();
+        write_atomic(
+            &svg,
+            plots::scatter_chart(
+                "Pareto front: mass, peak pin force, safety factor",
+                "mass [kg]",
+                "peak crank–rod pin force [N]",
+                &points,
+                "on the Pareto front",
+            )?
+            .as_bytes(),
+        )?;
+        written.extend([md, csv_path, svg]);
     }
     let index = out.join("index.html");
     write_atomic(&index, index_page::index_html(results, out).as_bytes())?;

@@ -246,3 +246,107 @@ pub fn bar_chart(title: &str, y_label: &str, bars: &[(String, f64)]) -> Result<S
     }
     Ok(svg)
 }
+
+/// A labelled point of a scatter chart; `highlight` draws it filled and larger.
+pub struct LabelledPoint {
+    pub label: String,
+    pub x: f64,
+    pub y: f64,
+    pub highlight: bool,
+}
+
+/// A scatter chart of labelled points (highlighted ones filled and joined by a line in x order:
+/// e.g. a Pareto front), as SVG text.
+pub fn scatter_chart(
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    points: &[LabelledPoint],
+    highlight_name: &str,
+) -> Result<String> {
+    let series = [Series {
+        name: String::new(),
+        points: points.iter().map(|p| (p.x, p.y)).collect(),
+    }];
+    let (x0, x1) = range(&series, |p| p.0, Scale::Linear);
+    let (y0, y1) = range(&series, |p| p.1, Scale::Linear);
+    if !(x0.is_finite() && x1.is_finite() && y0.is_finite() && y1.is_finite()) {
+        return Err(anyhow!("{title}: nothing to plot"));
+    }
+    // room for the labels right of the points
+    let (x0, x1) = (x0, x1 + 0.15 * (x1 - x0).max(1e-12));
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (960, 640)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 22))
+            .margin(12)
+            .x_label_area_size(52)
+            .y_label_area_size(90)
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .map_err(|e| anyhow!("{e}"))?;
+        chart
+            .configure_mesh()
+            .x_desc(x_label)
+            .y_desc(y_label)
+            .axis_desc_style(("sans-serif", 16))
+            .label_style(("sans-serif", 14))
+            .light_line_style(RGBColor(235, 235, 235))
+            .x_label_formatter(&|v| tick(*v, Scale::Linear))
+            .y_label_formatter(&|v| tick(*v, Scale::Linear))
+            .draw()
+            .map_err(|e| anyhow!("{e}"))?;
+        let mut front: Vec<(f64, f64)> = points
+            .iter()
+            .filter(|p| p.highlight)
+            .map(|p| (p.x, p.y))
+            .collect();
+        front.sort_by(|a, b| a.0.total_cmp(&b.0));
+        chart
+            .draw_series(LineSeries::new(front, COLOURS[3].stroke_width(2)))
+            .map_err(|e| anyhow!("{e}"))?;
+        for p in points {
+            let (colour, size) = if p.highlight {
+                (COLOURS[3], 7)
+            } else {
+                (COLOURS[0], 5)
+            };
+            let style = if p.highlight {
+                colour.filled()
+            } else {
+                colour.stroke_width(2)
+            };
+            // the marker and its label beside it, offset in pixels
+            let element = EmptyElement::at((p.x, p.y))
+                + Circle::new((0, 0), size, style)
+                + Text::new(p.label.clone(), (10, -7), ("sans-serif", 14).into_font());
+            chart
+                .draw_series(std::iter::once(element))
+                .map_err(|e| anyhow!("{e}"))?;
+        }
+        // the key, top left inside the plot
+        let key = [
+            (COLOURS[3], format!("{highlight_name} (filled)")),
+            (COLOURS[0], "dominated (open)".to_string()),
+        ];
+        for (k, (colour, text)) in key.iter().enumerate() {
+            let y = 70 + 22 * k as i32;
+            let style = if k == 0 {
+                colour.filled()
+            } else {
+                colour.stroke_width(2)
+            };
+            root.draw(&Circle::new((120, y), 6, style))
+                .map_err(|e| anyhow!("{e:?}"))?;
+            root.draw(&Text::new(
+                text.clone(),
+                (132, y - 8),
+                ("sans-serif", 15).into_font(),
+            ))
+            .map_err(|e| anyhow!("{e:?}"))?;
+        }
+        root.present().map_err(|e| anyhow!("{e}"))?;
+    }
+    Ok(svg)
+}

@@ -6,6 +6,7 @@
 //! whose FEM stage failed keeps its mass and peak force but is not ranked: it follows the ranked
 //! designs, without a rank, with the failing stage and its message as its status.
 
+use super::cycle_stage::DesignCycle;
 use super::fem_stage::DesignFem;
 use super::{DesignResult, FailedDesign, StudyResults};
 use crate::geometry::design::DesignMass;
@@ -55,7 +56,10 @@ pub struct RankRow<'a> {
     pub mass: &'a DesignMass,
     pub dynamics: Option<&'a DesignDynamics>,
     pub fem: Option<&'a DesignFem>,
+    pub cycle: Option<&'a DesignCycle>,
     pub status: Status,
+    /// On the Pareto front (mass, force, safety factor); see [`super::pareto`].
+    pub pareto: bool,
 }
 
 impl RankRow<'_> {
@@ -77,10 +81,32 @@ impl RankRow<'_> {
             })
             .unwrap_or_default()
     }
+    /// Why a design fails: `static`, `fatigue` or both (empty when it passes or is not judged).
+    pub fn failing_on(&self) -> String {
+        let Some(f) = self.fem else {
+            return String::new();
+        };
+        let c = &f.criterion;
+        let fatigue = c
+            .fatigue_safety_factor
+            .zip(c.fatigue_required)
+            .is_some_and(|(n, r)| n < r);
+        match (!c.static_pass, fatigue) {
+            (true, true) => "static and fatigue".into(),
+            (true, false) => "static".into(),
+            (false, true) => "fatigue".into(),
+            (false, false) => String::new(),
+        }
+    }
 }
 
 /// The ranking of a study: every design that passed stage 1, in report order.
 pub fn ranking(results: &StudyResults) -> Vec<RankRow<'_>> {
+    let front: Vec<String> = super::pareto::pareto(results)
+        .into_iter()
+        .filter(|r| r.on_front)
+        .map(|r| r.id)
+        .collect();
     let fails = |d: &DesignResult| d.fem.as_ref().is_some_and(|f| !f.criterion.pass);
     let mut done: Vec<&DesignResult> = results.designs.iter().collect();
     done.sort_by(|a, b| {
@@ -106,6 +132,8 @@ pub fn ranking(results: &StudyResults) -> Vec<RankRow<'_>> {
             mass: &d.mass,
             dynamics: Some(&d.dynamics),
             fem: d.fem.as_ref(),
+            cycle: d.cycle.as_ref(),
+            pareto: front.contains(&d.mass.id),
             status: match &d.fem {
                 None => Status::NotJudged,
                 Some(f) if f.criterion.pass => Status::Pass,
@@ -119,6 +147,8 @@ pub fn ranking(results: &StudyResults) -> Vec<RankRow<'_>> {
             mass: f.mass.as_ref()?,
             dynamics: f.dynamics.as_ref(),
             fem: None,
+            cycle: None,
+            pareto: false,
             status: Status::StageFailed {
                 stage: f.stage.clone(),
                 error: f.error.clone(),
@@ -161,10 +191,19 @@ struct CsvRow<'a> {
     fy_estimated_error_rel: Option<f64>,
     fy_von_mises_averaged_mpa: Option<f64>,
     fy_von_mises_unaveraged_mpa: Option<f64>,
+    /// The cycle stage: max von Mises over one revolution (inertia relief), its crank angle, and
+    /// the smallest Goodman fatigue safety factor.
+    cycle_max_von_mises_mpa: Option<f64>,
+    cycle_crank_angle_of_max_deg: Option<f64>,
+    fatigue_safety_factor: Option<f64>,
     max_displacement_mm: Option<f64>,
+    /// On the Pareto front of mass, peak force and safety factor (`pareto.md`).
+    pareto_front: bool,
     allowed_mpa: Option<f64>,
     safety_factor: Option<f64>,
     status: String,
+    /// `static`, `fatigue` or `static and fatigue` for a design that fails.
+    failing_on: String,
     /// Where the linear model is out of its depth (beyond yield, large displacement), `; `-joined.
     model_validity: String,
     /// The failing stage's message, for a design that did not pass every stage.
@@ -195,15 +234,20 @@ pub fn csv(results: &StudyResults) -> Result<Vec<u8>> {
             fy_estimated_error_rel: fy.map(|c| c.estimated_error_rel),
             fy_von_mises_averaged_mpa: fy.map(|c| c.max_von_mises_averaged_mpa),
             fy_von_mises_unaveraged_mpa: fy.map(|c| c.max_von_mises_unaveraged_mpa),
+            cycle_max_von_mises_mpa: r.cycle.map(|c| c.max_von_mises_over_cycle_mpa),
+            cycle_crank_angle_of_max_deg: r.cycle.map(|c| c.crank_angle_of_max_deg),
+            fatigue_safety_factor: r.cycle.map(|c| c.fatigue_safety_factor),
             max_displacement_mm: f.map(|f| {
                 f.fem
                     .fx
                     .max_displacement_mm
                     .max(f.fem.fy.max_displacement_mm)
             }),
+            pareto_front: r.pareto,
             allowed_mpa: f.map(|f| f.criterion.allowed_mpa),
             safety_factor: f.map(|f| f.criterion.safety_factor),
             status: r.status.word(),
+            failing_on: r.failing_on(),
             model_validity: r.model_validity(),
             error: match &r.status {
                 Status::StageFailed { error, .. } => error.clone(),
@@ -215,23 +259,26 @@ pub fn csv(results: &StudyResults) -> Result<Vec<u8>> {
 }
 
 /// The column headers of the ranking table for people (md and html).
-pub const HEADERS: [&str; 12] = [
+pub const HEADERS: [&str; 15] = [
     "rank",
     "design",
     "status",
     "safety factor",
     "σ F_x [MPa]",
     "σ F_y [MPa]",
+    "σ max over the cycle [MPa]",
+    "fatigue safety factor",
     "peak pin force [N]",
     "mass [kg]",
     "l1 [mm]",
     "I_zz [kg·m²]",
     "I_xx [kg·m²]",
     "max displ. [mm]",
+    "Pareto front",
 ];
 
 /// The cells of one row of the table for people, in [`HEADERS`] order (plain text).
-pub fn cells(r: &RankRow) -> [String; 12] {
+pub fn cells(r: &RankRow) -> [String; 15] {
     let dash = || "—".to_string();
     let stress = |c: Option<&crate::fem::LoadCaseResult>| {
         c.map_or_else(dash, |c| {
@@ -245,18 +292,29 @@ pub fn cells(r: &RankRow) -> [String; 12] {
         })
     };
     let f = r.fem;
-    let validity = r.model_validity();
+    let notes: Vec<String> = [r.failing_on(), r.model_validity()]
+        .into_iter()
+        .filter(|s| !s.is_empty())
+        .collect();
     [
         r.rank.map_or_else(dash, |k| k.to_string()),
         r.mass.design.clone(),
-        if validity.is_empty() {
+        if notes.is_empty() {
             r.status.word()
         } else {
-            format!("{} ({validity})", r.status.word())
+            format!("{} ({})", r.status.word(), notes.join("; "))
         },
         f.map_or_else(dash, |f| format!("{:.2}", f.criterion.safety_factor)),
         stress(f.map(|f| &f.fem.fx)),
         stress(f.map(|f| &f.fem.fy)),
+        r.cycle.map_or_else(dash, |c| {
+            format!(
+                "{:.1} at φ = {:.0}°",
+                c.max_von_mises_over_cycle_mpa, c.crank_angle_of_max_deg
+            )
+        }),
+        r.cycle
+            .map_or_else(dash, |c| format!("{:.2}", c.fatigue_safety_factor)),
         r.peak_force_n().map_or_else(dash, |v| format!("{v:.1}")),
         format!("{:.4}", r.mass.mass_kg),
         format!("{:.2}", r.mass.l1_m * 1e3),
@@ -271,6 +329,11 @@ pub fn cells(r: &RankRow) -> [String; 12] {
                     .max(f.fem.fy.max_displacement_mm)
             )
         }),
+        if r.pareto {
+            "yes".into()
+        } else {
+            String::new()
+        },
     ]
 }
 
@@ -281,7 +344,7 @@ pub fn explanation(results: &StudyResults) -> String {
         return "The FEM stage was skipped: no design is judged on stress; ranked by the peak crank–rod pin force of the driven crank–slider, lowest first.".into();
     }
     format!(
-        "Designs that meet the stress criterion first (max von Mises away from the fixed bore ≤ yield {} MPa / safety factor {} = {:.1} MPa, in both the F_x and F_y cases{}), then by the peak crank–rod pin force of the driven crank–slider, lowest first; a design whose FEM stage failed keeps its mass and force but is not ranked. Stresses [MPa] per case: away from the fixed bore and from sharp re-entrant edges (the convergent measure, judged) ± its estimated error / nodally averaged / raw element-nodal peak (at the fixed edge, a singularity, shown for reference).",
+        "Designs that meet the stress criterion first (max von Mises away from the fixed bore ≤ yield {} MPa / safety factor {} = {:.1} MPa, in both the F_x and F_y cases{}{}), then by the peak crank–rod pin force of the driven crank–slider, lowest first; a design whose FEM stage failed keeps its mass and force but is not ranked. Stresses [MPa] per case: away from the fixed bore and from sharp re-entrant edges (the convergent measure, judged) ± its estimated error / nodally averaged / raw element-nodal peak (at the fixed edge, a singularity, shown for reference).",
         c.yield_mpa,
         c.safety_factor,
         c.yield_mpa / c.safety_factor,
@@ -289,6 +352,16 @@ pub fn explanation(results: &StudyResults) -> String {
             ", the peak plus its estimated error"
         } else {
             ""
+        },
+        if c.fatigue && !results.stages_skipped.iter().any(|s| s == "cycle") {
+            format!(
+                "; and a Goodman fatigue safety factor ≥ {} over one revolution with inertia relief, Se {} / Sut {} MPa",
+                c.fatigue_safety_factor,
+                results.config.material.endurance_mpa,
+                results.config.material.ultimate_mpa
+            )
+        } else {
+            String::new()
         }
     )
 }

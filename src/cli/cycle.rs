@@ -1,0 +1,152 @@
+//! `rodstudy cycle DESIGN [--mesh FILE] [--size MM | --target-error R] [--config FILE] [--json]
+//! [--out DIR]`: stress over one crank revolution with inertia relief, and the fatigue safety
+//! factor, on the mesh stage 3 ends on.
+
+use crate::geometry::design::mass_of_design;
+use crate::mechanism::Method;
+use crate::study::config::StudyConfig;
+use crate::study::cycle_stage::{DesignCycle, cycle_of_design};
+use crate::study::dynamics_stage::dynamics_of_design;
+use crate::study::fem_stage::{MeshMode, fem_of_design_with_mesh};
+use anyhow::{Result, bail};
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Args)]
+pub struct CycleArgs {
+    /// The STL design (its sidecar gives units, pins, axis and density).
+    design: PathBuf,
+    /// Use this ready tet10 volume mesh instead of meshing the STL.
+    #[arg(long)]
+    mesh: Option<PathBuf>,
+    /// One fixed mesh of this element size [mm] instead of adaptive refinement.
+    #[arg(long, conflicts_with = "target_error")]
+    size: Option<f64>,
+    /// Adaptive refinement of the static cases to this estimated error (default: the
+    /// configuration's `fem.target_error`); the cycle runs on the final mesh.
+    #[arg(long)]
+    target_error: Option<f64>,
+    /// Settings file (as for `study`).
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Print the result as JSON.
+    #[arg(long)]
+    json: bool,
+    /// Folder for cycle.vtu, von_mises_cycle.svg and the stage-3 files.
+    #[arg(long, default_value = "reports/cycle")]
+    out: PathBuf,
+}
+
+/// `cycle --json`: the cycle record with the static stage's time on the same mesh beside it.
+#[derive(serde::Serialize)]
+struct CycleJson<'a> {
+    #[serde(flatten)]
+    cycle: &'a DesignCycle,
+    /// Elements and DOFs of the mesh.
+    elements: usize,
+    dofs: usize,
+    /// Wall time of the static two-case analysis on this mesh (the last one of stage 3: assembly,
+    /// factorisation, solves, stresses, recovery, estimate; no files), s.
+    static_stage_s: f64,
+}
+
+pub fn run(args: CycleArgs) -> Result<i32> {
+    let mut config = StudyConfig::load(args.config.as_deref())?;
+    if let Some(size) = args.size {
+        if !(size.is_finite() && size > 0.0) {
+            bail!("--size must be a positive number of mm, got {size}");
+        }
+        config.fem.mesh_size_mm = size;
+    }
+    if let Some(t) = args.target_error {
+        if !(t.is_finite() && t > 0.0 && t < 1.0) {
+            bail!("--target-error must lie in (0, 1), got {t}");
+        }
+        config.fem.target_error = t;
+    }
+    let mode = match (&args.mesh, args.size) {
+        (Some(file), _) => MeshMode::User(file.clone()),
+        (None, Some(size)) => MeshMode::Fixed(size),
+        (None, None) => MeshMode::from_config(&config),
+    };
+    let mass = mass_of_design(&args.design)?;
+    let (dynamics, _) = dynamics_of_design(
+        &mass,
+        &config.driven_scene(),
+        config.driven.gravity,
+        Method::ClosedForm,
+    )?;
+    let (fem, mesh) = fem_of_design_with_mesh(
+        &args.design,
+        dynamics.peak_pin_force_n,
+        &config,
+        &args.out.join("mesh"),
+        &args.out,
+        &mode,
+    )?;
+    let (cycle, _, _) = cycle_of_design(&mass, &mesh, &config, Some(&args.out))?;
+    // the static two-case analysis of the final mesh (assembly, factorisation, solves, stresses,
+    // recovery and estimate), for the cost ratio
+    let t = &fem.fem.timings;
+    let static_s = t.assembly_s + t.symbolic_s + t.factorisation_s + t.solve_s + t.stress_s;
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&CycleJson {
+                cycle: &cycle,
+                elements: mesh.mesh.n_elements(),
+                dofs: mesh.mesh.n_dofs(),
+                static_stage_s: static_s,
+            })?
+        );
+    } else {
+        println!(
+            "{}: {} instants over one revolution at {:.2} rad/s, mesh {} elements / {} DOFs",
+            mass.design,
+            cycle.instants,
+            cycle.omega_rad_s,
+            mesh.mesh.n_elements(),
+            mesh.mesh.n_dofs()
+        );
+        println!(
+            "max von Mises over the cycle (away from the fixed bore): {:.2} MPa at φ = {:.1}°, at ({:.1}, {:.1}, {:.1}) mm",
+            cycle.max_von_mises_over_cycle_mpa,
+            cycle.crank_angle_of_max_deg,
+            cycle.location_of_max_mm[0],
+            cycle.location_of_max_mm[1],
+            cycle.location_of_max_mm[2]
+        );
+        println!(
+            "fatigue (Goodman, Se {:.0} / Sut {:.0} MPa): safety factor {:.2} at ({:.1}, {:.1}, {:.1}) mm, σa {:.2} MPa, σm {:.2} MPa",
+            cycle.endurance_mpa,
+            cycle.ultimate_mpa,
+            cycle.fatigue_safety_factor,
+            cycle.fatigue_location_mm[0],
+            cycle.fatigue_location_mm[1],
+            cycle.fatigue_location_mm[2],
+            cycle.fatigue_alternating_mpa,
+            cycle.fatigue_mean_mpa
+        );
+        println!(
+            "reaction at B against the dynamics' F_B: largest difference {:.2e} of the peak pin force ({:.1} N); mesh mass {:.4} kg (STL {:.4} kg)",
+            cycle.reaction_mismatch_rel,
+            cycle.peak_pin_force_n,
+            cycle.mesh_mass_kg,
+            cycle.stl_mass_kg
+        );
+        println!(
+            "time: cycle analysis {:.2} s (six unit solves, {} instants combined; {:.2} s with its files), static two-case analysis of the same mesh {:.2} s: ratio {:.2}",
+            cycle.analysis_seconds,
+            cycle.instants,
+            cycle.seconds,
+            static_s,
+            cycle.analysis_seconds / static_s
+        );
+        eprintln!(
+            "wrote {} and {}",
+            args.out.join("cycle.vtu").display(),
+            args.out.join("von_mises_cycle.svg").display()
+        );
+    }
+    Ok(0)
+}
