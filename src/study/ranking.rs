@@ -158,19 +158,6 @@ pub fn ranking(results: &StudyResults) -> Vec<RankRow<'_>> {
     rows
 }
 
-/// The designs that passed every stage, in ranking order.
-pub fn ranked(results: &StudyResults) -> Vec<&DesignResult> {
-    ranking(results)
-        .into_iter()
-        .filter_map(|r| {
-            results
-                .designs
-                .iter()
-                .find(|d| std::ptr::eq(&d.mass, r.mass))
-        })
-        .collect()
-}
-
 /// One row of `ranking.csv` (SI units but stresses in MPa; empty where a stage was skipped or
 /// failed).
 #[derive(Serialize)]
