@@ -26,50 +26,156 @@ pub struct VolumeMoments {
     pub second: Matrix3<f64>,
 }
 
-impl VolumeMoments {
-    const ZERO: Self = VolumeMoments {
-        volume: 0.0,
-        first: Vector3::new(0.0, 0.0, 0.0),
-        second: Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
-    };
-
-    fn add(mut self, other: &Self) -> Self {
-        self.volume += other.volume;
-        self.first += other.first;
-        self.second += other.second;
-        self
-    }
-}
-
 /// Triangles per parallel work item; partial sums are added in a fixed order, so the result
 /// does not depend on thread scheduling.
 const CHUNK: usize = 8192;
 
-/// The volume moments of the solid bounded by `mesh` about `reference` (see module docs).
-pub fn volume_moments(mesh: &IndexedMesh, reference: Vector3<f64>) -> VolumeMoments {
-    let partial: Vec<VolumeMoments> = mesh
+/// Running sums of one pass: the volume, the first moment and the second moment as its upper
+/// triangle (xx, xy, xz, yy, yz, zz).
+#[derive(Clone, Copy)]
+struct Sums {
+    volume: f64,
+    first: [f64; 3],
+    second: [f64; 6],
+}
+
+/// The (row, column) of each entry of [`Sums::second`].
+const UPPER: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+
+impl Sums {
+    const ZERO: Self = Sums {
+        volume: 0.0,
+        first: [0.0; 3],
+        second: [0.0; 6],
+    };
+
+    fn add(mut self, other: &Self) -> Self {
+        self.volume += other.volume;
+        for (sum, x) in self.first.iter_mut().zip(other.first) {
+            *sum += x;
+        }
+        for (sum, x) in self.second.iter_mut().zip(other.second) {
+            *sum += x;
+        }
+        self
+    }
+}
+
+/// How far a pass of [`sums`] goes: the volume only, also the first moment, or all three.
+const VOLUME: u8 = 0;
+const FIRST: u8 = 1;
+const SECOND: u8 = 2;
+
+/// The corners of a triangle relative to the reference point `r`.
+#[inline(always)]
+fn relative_corners(mesh: &IndexedMesh, tri: &[u32; 3], r: &[f64; 3]) -> [[f64; 3]; 3] {
+    // Spelled out: `array::map` is not always inlined.
+    let corner = |i: u32| {
+        let v = &mesh.vertices[i as usize];
+        [v.x - r[0], v.y - r[1], v.z - r[2]]
+    };
+    [corner(tri[0]), corner(tri[1]), corner(tri[2])]
+}
+
+/// The signed volume a · (b × c) / 6 of the tetrahedron (reference, a, b, c).
+#[inline(always)]
+fn tetrahedron_volume([a, b, c]: &[[f64; 3]; 3]) -> f64 {
+    let cross = [
+        b[1] * c[2] - b[2] * c[1],
+        b[2] * c[0] - b[0] * c[2],
+        b[0] * c[1] - b[1] * c[0],
+    ];
+    (a[0] * cross[0] + a[1] * cross[1] + a[2] * cross[2]) / 6.0
+}
+
+/// The sums over the tetrahedra (reference, a, b, c) of the formulas in the module docs, up to
+/// the moment `ORDER`, in plain f64 arithmetic: each operation is the one nalgebra's vector and
+/// matrix expressions perform, in the same order (sum of products left to right, outer products
+/// `aᵢ·aⱼ`), so the digits are those of the straightforward nalgebra code; the second moment's
+/// symmetry is used (its entry (i, j) is bit for bit its entry (j, i)), so six entries are
+/// summed rather than nine.
+fn sums<const ORDER: u8>(mesh: &IndexedMesh, reference: Vector3<f64>) -> Sums {
+    let r = [reference.x, reference.y, reference.z];
+    let partial: Vec<Sums> = mesh
         .triangles
         .par_chunks(CHUNK)
         .map(|chunk| {
-            chunk.iter().fold(VolumeMoments::ZERO, |acc, tri| {
-                let [a, b, c] = tri.map(|i| mesh.vertices[i as usize] - reference);
-                let volume = a.dot(&b.cross(&c)) / 6.0;
-                let s = a + b + c;
-                let outer = a * a.transpose() + b * b.transpose() + c * c.transpose();
-                acc.add(&VolumeMoments {
-                    volume,
-                    first: s * (volume / 4.0),
-                    second: (outer + s * s.transpose()) * (volume / 20.0),
-                })
-            })
+            let mut acc = Sums::ZERO;
+            for tri in chunk {
+                let corners = relative_corners(mesh, tri, &r);
+                let volume = tetrahedron_volume(&corners);
+                acc.volume += volume;
+                if ORDER >= FIRST {
+                    let [a, b, c] = corners;
+                    let s = [a[0] + b[0] + c[0], a[1] + b[1] + c[1], a[2] + b[2] + c[2]];
+                    let q = volume / 4.0;
+                    for (sum, s) in acc.first.iter_mut().zip(s) {
+                        *sum += s * q;
+                    }
+                    if ORDER >= SECOND {
+                        let q = volume / 20.0;
+                        for (k, &(i, j)) in UPPER.iter().enumerate() {
+                            acc.second[k] +=
+                                (a[i] * a[j] + b[i] * b[j] + c[i] * c[j] + s[i] * s[j]) * q;
+                        }
+                    }
+                }
+            }
+            acc
         })
         .collect();
-    partial.iter().fold(VolumeMoments::ZERO, VolumeMoments::add)
+    partial.iter().fold(Sums::ZERO, Sums::add)
 }
 
-/// Signed enclosed volume (positive for an outward-oriented closed surface).
+/// The volume moments of the solid bounded by `mesh` about `reference` (see module docs).
+pub fn volume_moments(mesh: &IndexedMesh, reference: Vector3<f64>) -> VolumeMoments {
+    let s = sums::<SECOND>(mesh, reference);
+    let [xx, xy, xz, yy, yz, zz] = s.second;
+    VolumeMoments {
+        volume: s.volume,
+        first: Vector3::from(s.first),
+        second: Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz),
+    }
+}
+
+/// Signed enclosed volume (positive for an outward-oriented closed surface): the volume of
+/// [`volume_moments`] about the bounding-box centre, to the last digit.
 pub fn signed_volume(mesh: &IndexedMesh) -> f64 {
-    volume_moments(mesh, bounding_box_centre(mesh)).volume
+    sums::<VOLUME>(mesh, bounding_box_centre(mesh)).volume
+}
+
+/// [`signed_volume`] (to the last digit) and, in the same pass over the triangles (one fetch of
+/// their corners for both), the triangles for which `flag(vertex indices, corners)` holds, in
+/// increasing order.
+pub fn signed_volume_and_flagged(
+    mesh: &IndexedMesh,
+    flag: impl Fn(&[u32; 3], &[Vector3<f64>; 3]) -> bool + Sync,
+) -> (f64, Vec<usize>) {
+    let reference = bounding_box_centre(mesh);
+    let r = [reference.x, reference.y, reference.z];
+    let partial: Vec<(f64, Vec<usize>)> = mesh
+        .triangles
+        .par_chunks(CHUNK)
+        .enumerate()
+        .map(|(k, chunk)| {
+            let mut volume = 0.0;
+            let mut flagged = Vec::new();
+            for (i, tri) in chunk.iter().enumerate() {
+                let corners = [
+                    mesh.vertices[tri[0] as usize],
+                    mesh.vertices[tri[1] as usize],
+                    mesh.vertices[tri[2] as usize],
+                ];
+                if flag(tri, &corners) {
+                    flagged.push(k * CHUNK + i);
+                }
+                volume += tetrahedron_volume(&relative_corners(mesh, tri, &r));
+            }
+            (volume, flagged)
+        })
+        .collect();
+    let volume = partial.iter().fold(0.0, |v, (p, _)| v + p);
+    (volume, partial.into_iter().flat_map(|(_, f)| f).collect())
 }
 
 fn bounding_box_centre(mesh: &IndexedMesh) -> Vector3<f64> {
@@ -96,16 +202,17 @@ impl MassProperties {
     /// Integrates the solid bounded by a validated, outward-oriented `mesh`.
     pub fn of_mesh(mesh: &IndexedMesh, density: f64) -> Self {
         let near = bounding_box_centre(mesh);
-        let rough = volume_moments(mesh, near);
-        let centroid = near + rough.first / rough.volume;
+        let rough = sums::<FIRST>(mesh, near);
+        let volume = rough.volume;
+        let centroid = near + Vector3::from(rough.first) / volume;
         // Second pass about the centroid itself: no parallel-axis subtraction needed.
         let about_centroid = volume_moments(mesh, centroid);
         let s = about_centroid.second;
         let inertia = (Matrix3::identity() * s.trace() - s) * density;
         let (principal_moments, principal_axes) = principal(&inertia);
         MassProperties {
-            volume: rough.volume,
-            mass: rough.volume * density,
+            volume,
+            mass: volume * density,
             centroid,
             inertia,
             principal_moments,
@@ -157,6 +264,78 @@ mod tests {
     /// A rotation with no special alignment to the axes.
     fn skew_rotation() -> Matrix3<f64> {
         *Rotation3::from_euler_angles(0.3, -1.1, 2.4).matrix()
+    }
+
+    /// The moments as the nalgebra expressions of the formulas give them (the code before the
+    /// plain-f64 kernel), chunked and summed in the same order.
+    fn nalgebra_moments(mesh: &IndexedMesh, reference: Vector3<f64>) -> VolumeMoments {
+        let zero = VolumeMoments {
+            volume: 0.0,
+            first: Vector3::zeros(),
+            second: Matrix3::zeros(),
+        };
+        let add = |mut acc: VolumeMoments, other: &VolumeMoments| {
+            acc.volume += other.volume;
+            acc.first += other.first;
+            acc.second += other.second;
+            acc
+        };
+        let partial: Vec<VolumeMoments> = mesh
+            .triangles
+            .chunks(CHUNK)
+            .map(|chunk| {
+                chunk.iter().fold(zero, |acc, tri| {
+                    let [a, b, c] = tri.map(|i| mesh.vertices[i as usize] - reference);
+                    let volume = a.dot(&b.cross(&c)) / 6.0;
+                    let s = a + b + c;
+                    let outer = a * a.transpose() + b * b.transpose() + c * c.transpose();
+                    let term = VolumeMoments {
+                        volume,
+                        first: s * (volume / 4.0),
+                        second: (outer + s * s.transpose()) * (volume / 20.0),
+                    };
+                    add(acc, &term)
+                })
+            })
+            .collect();
+        partial.iter().fold(zero, add)
+    }
+
+    #[test]
+    fn the_kernel_gives_the_digits_of_the_nalgebra_expressions() {
+        let bits = |m: &VolumeMoments| {
+            let mut b = vec![m.volume.to_bits()];
+            b.extend(m.first.iter().map(|x| x.to_bits()));
+            b.extend(m.second.iter().map(|x| x.to_bits()));
+            b
+        };
+        let rod = voxel_rod().0;
+        let far = transformed(&rod, &skew_rotation(), Vector3::new(1.0e4, -7.0e3, 5.0e3));
+        // More than one chunk, so that the order of the partial sums counts too.
+        let big_torus = torus(0.1, 0.03, 300, 100);
+        assert!(big_torus.triangles.len() > 3 * CHUNK);
+        for mesh in [rod, far, big_torus, hollow_cylinder(0.04, 0.025, 0.03, 64)] {
+            let (lo, hi) = mesh.bounding_box();
+            for reference in [
+                (lo + hi) / 2.0,
+                Vector3::zeros(),
+                Vector3::new(0.3, -0.2, 0.1),
+            ] {
+                let ours = volume_moments(&mesh, reference);
+                let expected = nalgebra_moments(&mesh, reference);
+                assert_eq!(bits(&ours), bits(&expected));
+            }
+            let expected = nalgebra_moments(&mesh, (lo + hi) / 2.0).volume;
+            assert_eq!(signed_volume(&mesh).to_bits(), expected.to_bits());
+            let (volume, flagged) = signed_volume_and_flagged(&mesh, |_, _| false);
+            assert_eq!(volume.to_bits(), expected.to_bits());
+            assert!(flagged.is_empty());
+            let odd = signed_volume_and_flagged(&mesh, |t, _| t[0] % 2 == 1).1;
+            let expected_odd: Vec<usize> = (0..mesh.triangles.len())
+                .filter(|&t| mesh.triangles[t][0] % 2 == 1)
+                .collect();
+            assert_eq!(odd, expected_odd);
+        }
     }
 
     #[test]

@@ -8,8 +8,9 @@
 //! consistently inward-facing surface is flipped, with a warning; anything else is refused.
 
 use super::error::{Location, MeshError};
-use super::mass_properties::signed_volume;
+use super::mass_properties::signed_volume_and_flagged;
 use super::weld::IndexedMesh;
+use nalgebra::Vector3;
 use rayon::prelude::*;
 
 /// A mesh that passed [`validate`], with what had to be done to it.
@@ -28,20 +29,22 @@ pub fn validate(mut mesh: IndexedMesh) -> Result<ValidMesh, MeshError> {
     if mesh.triangles.is_empty() {
         return Err(MeshError::NoTriangles);
     }
-    check_degenerate(&mesh)?;
-    let pairs = check_edges(&mesh)?;
+    // The volume is summed in the pass that looks for degenerate triangles; it is needed last.
+    let volume = check_degenerate(&mesh)?;
+    let ranges = rayon::current_num_threads()
+        .min(mesh.vertices.len().div_ceil(4096))
+        .max(1);
+    let pairs = check_edges(&mesh, ranges)?;
     check_one_shell(&mesh, &pairs)?;
+    drop(pairs);
     let mut warnings = Vec::new();
-    let volume = signed_volume(&mesh);
     let (lo, hi) = mesh.bounding_box();
     let box_volume: f64 = (0..3).map(|k| hi[k] - lo[k]).product();
     if volume.is_nan() || volume.abs() <= 1e-12 * box_volume {
         return Err(MeshError::ZeroVolume { volume });
     }
     if volume < 0.0 {
-        for t in &mut mesh.triangles {
-            t.swap(1, 2);
-        }
+        mesh.triangles.par_iter_mut().for_each(|t| t.swap(1, 2));
         warnings.push(
             "all triangles faced inward (negative volume); the orientation was flipped".into(),
         );
@@ -49,56 +52,152 @@ pub fn validate(mut mesh: IndexedMesh) -> Result<ValidMesh, MeshError> {
     Ok(ValidMesh { mesh, warnings })
 }
 
-fn check_degenerate(mesh: &IndexedMesh) -> Result<(), MeshError> {
-    let is_degenerate = |t: usize| {
-        let [a, b, c] = mesh.triangles[t];
+/// Refuses degenerate triangles; returns the signed volume (that of
+/// [`signed_volume`](super::mass_properties::signed_volume), summed in the same pass).
+fn check_degenerate(mesh: &IndexedMesh) -> Result<f64, MeshError> {
+    // Plain f64 arithmetic, the operations of nalgebra's `q - p`, `norm_squared`, `cross` and
+    // `norm` in their order.
+    let is_degenerate = |&[a, b, c]: &[u32; 3], &[p, q, r]: &[Vector3<f64>; 3]| {
         if a == b || b == c || a == c {
             return true;
         }
-        let [p, q, r] = mesh.corners(t);
-        let (u, v, w) = (q - p, r - p, r - q);
-        let longest = u.norm_squared().max(v.norm_squared()).max(w.norm_squared());
-        u.cross(&v).norm() <= DEGENERATE_SINE * longest
+        let minus = |x: Vector3<f64>, y: Vector3<f64>| [x.x - y.x, x.y - y.y, x.z - y.z];
+        let (u, v, w) = (minus(q, p), minus(r, p), minus(r, q));
+        let squared = |x: [f64; 3]| x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
+        let longest = squared(u).max(squared(v)).max(squared(w));
+        let cross = [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ];
+        squared(cross).sqrt() <= DEGENERATE_SINE * longest
     };
-    let bad: Vec<usize> = (0..mesh.triangles.len())
-        .into_par_iter()
-        .filter(|&t| is_degenerate(t))
-        .collect();
+    let (volume, bad) = signed_volume_and_flagged(mesh, is_degenerate);
     match bad.first() {
         Some(&triangle) => Err(MeshError::Degenerate {
             count: bad.len(),
             triangle,
             at: Location::from(mesh.vertices[mesh.triangles[triangle][0] as usize]),
         }),
-        None => Ok(()),
+        None => Ok(volume),
     }
 }
 
-/// An edge-use: the undirected edge as `(min << 32) | max`, and whether the triangle runs it
-/// from min to max.
-#[derive(Clone, Copy)]
-struct EdgeUse {
-    key: u64,
-    forward: bool,
-    triangle: u32,
+/// What grouping the edge-uses by edge found in one range of vertices: the defects (each edge
+/// as `(min << 32) | max`, in increasing order).
+#[derive(Default)]
+struct EdgeDefects {
+    open: Vec<u64>,
+    non_manifold: Vec<(u64, usize)>,
+    inconsistent: Vec<u64>,
 }
 
-/// Pairs of triangles across each interior edge, after checking closedness, manifoldness and
-/// orientation.
-fn check_edges(mesh: &IndexedMesh) -> Result<Vec<(u32, u32)>, MeshError> {
-    let mut uses: Vec<EdgeUse> = mesh
-        .triangles
-        .par_iter()
-        .enumerate()
-        .flat_map_iter(|(t, &[a, b, c])| {
-            [(a, b), (b, c), (c, a)].map(|(i, j)| EdgeUse {
-                key: (u64::from(i.min(j)) << 32) | u64::from(i.max(j)),
-                forward: i < j,
-                triangle: t as u32,
-            })
+/// The pairs of triangles across the edges, after checking closedness, manifoldness and
+/// orientation: a flat list, two triangle numbers per edge, in increasing edge order.
+///
+/// Every edge-use (three per triangle) is filed under the lower-numbered vertex of its edge by a
+/// counting sort, as `3 × triangle + side`; the few uses filed under one vertex are then sorted
+/// by the other vertex, which brings the uses of each edge together (this replaces one sort of
+/// all 3T uses), and the two uses of each regular edge are overwritten by its two triangles.
+/// The vertices are cut into `ranges` ranges, one per thread; each range files its
+/// own uses (every range reads all triangles, but writes only its own vertices' slots), so no
+/// thread waits for another, and the defects come out in increasing edge order whatever the
+/// scheduling.
+fn check_edges(mesh: &IndexedMesh, ranges: usize) -> Result<Vec<u32>, MeshError> {
+    let (triangles, n) = (&mesh.triangles, mesh.vertices.len());
+    assert!(
+        triangles.len() < 1 << 30,
+        "too many triangles for the edge table"
+    );
+    let sides = |[a, b, c]: [u32; 3]| [(a, b), (b, c), (c, a)];
+    let bounds: Vec<usize> = (0..=ranges).map(|r| r * n / ranges).collect();
+    // The uses filed under each vertex, counted range by range.
+    let counts: Vec<Vec<u32>> = (0..ranges)
+        .into_par_iter()
+        .map(|r| {
+            let (first, last) = (bounds[r] as u32, bounds[r + 1] as u32);
+            let mut count = vec![0u32; (last - first) as usize];
+            for &t in triangles {
+                for (i, j) in sides(t) {
+                    let low = i.min(j);
+                    if (first..last).contains(&low) {
+                        count[(low - first) as usize] += 1;
+                    }
+                }
+            }
+            count
         })
         .collect();
-    uses.par_sort_unstable_by_key(|u| u.key);
+    let mut filed = vec![0u32; 3 * triangles.len()];
+    let mut regions = Vec::with_capacity(ranges);
+    let mut rest = filed.as_mut_slice();
+    for count in &counts {
+        let size = count.iter().map(|&c| c as usize).sum();
+        let (region, tail) = std::mem::take(&mut rest).split_at_mut(size);
+        regions.push(region);
+        rest = tail;
+    }
+    let defects: Vec<EdgeDefects> = regions
+        .into_par_iter()
+        .zip(counts)
+        .enumerate()
+        .map(|(r, (region, count))| {
+            let first = bounds[r] as u32;
+            // Counting sort: `next[v]` is where the next use filed under v goes; once all are
+            // filed, it is where v's uses end.
+            let mut next = count;
+            let mut at = 0;
+            for slot in &mut next {
+                let c = *slot;
+                *slot = at;
+                at += c;
+            }
+            for (t, &tri) in triangles.iter().enumerate() {
+                for (side, (i, j)) in sides(tri).into_iter().enumerate() {
+                    let low = i.min(j);
+                    if (first..first + next.len() as u32).contains(&low) {
+                        let slot = &mut next[(low - first) as usize];
+                        region[*slot as usize] = 3 * t as u32 + side as u32;
+                        *slot += 1;
+                    }
+                }
+            }
+            let mut found = EdgeDefects::default();
+            let mut uses: Vec<u64> = Vec::new();
+            let mut begin = 0;
+            for (v, &end) in next.iter().enumerate() {
+                let filed_here = &mut region[begin..end as usize];
+                begin = end as usize;
+                // (other vertex, forward, triangle) of each use, sorted by the other vertex.
+                uses.clear();
+                uses.extend(filed_here.iter().map(|&code| {
+                    let (t, side) = (code / 3, code % 3);
+                    let (i, j) = sides(triangles[t as usize])[side as usize];
+                    (u64::from(i.max(j)) << 32) | (u64::from(i < j) << 31) | u64::from(t)
+                }));
+                uses.sort_unstable();
+                let low = u64::from(first) + v as u64;
+                let mut pairs = filed_here.iter_mut();
+                for group in uses.chunk_by(|a, b| a >> 32 == b >> 32) {
+                    let key = (low << 32) | (group[0] >> 32);
+                    let forward = |w: u64| (w >> 31) & 1 == 1;
+                    match *group {
+                        [_] => found.open.push(key),
+                        [one, other] if forward(one) == forward(other) => {
+                            found.inconsistent.push(key)
+                        }
+                        [one, other] => {
+                            for w in [one, other] {
+                                *pairs.next().expect("a slot per use") = w as u32 & 0x7fff_ffff;
+                            }
+                        }
+                        ref more => found.non_manifold.push((key, more.len())),
+                    }
+                }
+            }
+            found
+        })
+        .collect();
 
     let location = |key: u64| {
         (
@@ -106,46 +205,35 @@ fn check_edges(mesh: &IndexedMesh) -> Result<Vec<(u32, u32)>, MeshError> {
             Location::from(mesh.vertices[(key & 0xffff_ffff) as usize]),
         )
     };
-    let (mut open, mut non_manifold, mut inconsistent) = (Vec::new(), Vec::new(), Vec::new());
-    let mut pairs = Vec::with_capacity(uses.len() / 2);
-    for group in uses.chunk_by(|a, b| a.key == b.key) {
-        match group {
-            [single] => open.push(single.key),
-            [first, second] if first.forward == second.forward => inconsistent.push(first.key),
-            [first, second] => pairs.push((first.triangle, second.triangle)),
-            more => non_manifold.push((more[0].key, more.len())),
-        }
+    let first_of = |pick: fn(&EdgeDefects) -> usize| {
+        let count: usize = defects.iter().map(pick).sum();
+        (count, defects.iter().position(|d| pick(d) > 0))
+    };
+    if let (count, Some(d)) = first_of(|d| d.open.len()) {
+        let (from, to) = location(defects[d].open[0]);
+        return Err(MeshError::Open { count, from, to });
     }
-    if let Some(&key) = open.first() {
-        let (from, to) = location(key);
-        return Err(MeshError::Open {
-            count: open.len(),
-            from,
-            to,
-        });
-    }
-    if let Some(&(key, faces)) = non_manifold.first() {
+    if let (count, Some(d)) = first_of(|d| d.non_manifold.len()) {
+        let (key, faces) = defects[d].non_manifold[0];
         let (from, to) = location(key);
         return Err(MeshError::NonManifold {
-            count: non_manifold.len(),
+            count,
             faces,
             from,
             to,
         });
     }
-    if let Some(&key) = inconsistent.first() {
-        let (from, to) = location(key);
-        return Err(MeshError::Inconsistent {
-            count: inconsistent.len(),
-            from,
-            to,
-        });
+    if let (count, Some(d)) = first_of(|d| d.inconsistent.len()) {
+        let (from, to) = location(defects[d].inconsistent[0]);
+        return Err(MeshError::Inconsistent { count, from, to });
     }
-    Ok(pairs)
+    Ok(filed)
 }
 
-/// Connected components of the triangles across shared edges (union–find with path halving).
-fn check_one_shell(mesh: &IndexedMesh, pairs: &[(u32, u32)]) -> Result<(), MeshError> {
+/// Connected components of the triangles across shared edges (union–find with path halving);
+/// `pairs` holds two triangle numbers per edge. Each union makes the lower root the root, so
+/// every root is the lowest triangle of its shell, whatever the order of the pairs.
+fn check_one_shell(mesh: &IndexedMesh, pairs: &[u32]) -> Result<(), MeshError> {
     let mut parent: Vec<u32> = (0..mesh.triangles.len() as u32).collect();
     fn root(parent: &mut [u32], mut i: u32) -> u32 {
         while parent[i as usize] != i {
@@ -154,11 +242,14 @@ fn check_one_shell(mesh: &IndexedMesh, pairs: &[(u32, u32)]) -> Result<(), MeshE
         }
         i
     }
-    for &(a, b) in pairs {
-        let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+    for pair in pairs.chunks_exact(2) {
+        let (ra, rb) = (root(&mut parent, pair[0]), root(&mut parent, pair[1]));
         if ra != rb {
             parent[ra.max(rb) as usize] = ra.min(rb);
         }
+    }
+    if (0..parent.len() as u32).all(|i| root(&mut parent, i) == 0) {
+        return Ok(());
     }
     let roots: Vec<u32> = (0..parent.len() as u32)
         .map(|i| root(&mut parent, i))
@@ -184,6 +275,7 @@ fn check_one_shell(mesh: &IndexedMesh, pairs: &[(u32, u32)]) -> Result<(), MeshE
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::mass_properties::signed_volume;
     use crate::geometry::primitives::{cuboid, flipped, torus, transformed, voxel_rod};
     use nalgebra::{Matrix3, Vector3};
 
@@ -280,6 +372,30 @@ mod tests {
             err.to_string().contains("(5.5"),
             "location of the second shell: {err}"
         );
+    }
+
+    #[test]
+    fn the_edge_check_does_not_depend_on_the_vertex_ranges() {
+        let torus = torus(1.0, 0.3, 24, 12);
+        let mut open = torus.clone();
+        open.triangles.truncate(open.triangles.len() - 7);
+        let mut inconsistent = torus.clone();
+        inconsistent.triangles[5].swap(0, 1);
+        inconsistent.triangles[200].swap(1, 2);
+        let a = cuboid(Vector3::repeat(1.0), Vector3::zeros());
+        let b = cuboid(Vector3::repeat(1.0), Vector3::new(1.0, 1.0, 0.0));
+        let non_manifold =
+            crate::geometry::weld::weld(&crate::geometry::primitives::to_soup(&union(&a, &b)));
+        let two_shells = union(
+            &torus,
+            &transformed(&torus, &Matrix3::identity(), Vector3::new(5.0, 0.0, 0.0)),
+        );
+        for mesh in [torus, open, inconsistent, non_manifold, two_shells] {
+            let one = format!("{:?}", check_edges(&mesh, 1));
+            for ranges in 2..=5 {
+                assert_eq!(format!("{:?}", check_edges(&mesh, ranges)), one);
+            }
+        }
     }
 
     #[test]
