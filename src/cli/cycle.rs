@@ -7,8 +7,8 @@ use crate::mechanism::Method;
 use crate::study::config::StudyConfig;
 use crate::study::cycle_stage::{DesignCycle, cycle_of_design};
 use crate::study::dynamics_stage::dynamics_of_design;
-use crate::study::fem_stage::{MeshMode, fem_of_design_with_mesh};
-use anyhow::{Result, bail};
+use crate::study::fem_stage::fem_of_design_with_mesh;
+use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -52,23 +52,12 @@ struct CycleJson<'a> {
 
 pub fn run(args: CycleArgs) -> Result<i32> {
     let mut config = StudyConfig::load(args.config.as_deref())?;
-    if let Some(size) = args.size {
-        if !(size.is_finite() && size > 0.0) {
-            bail!("--size must be a positive number of mm, got {size}");
-        }
-        config.fem.mesh_size_mm = size;
-    }
-    if let Some(t) = args.target_error {
-        if !(t.is_finite() && t > 0.0 && t < 1.0) {
-            bail!("--target-error must lie in (0, 1), got {t}");
-        }
-        config.fem.target_error = t;
-    }
-    let mode = match (&args.mesh, args.size) {
-        (Some(file), _) => MeshMode::User(file.clone()),
-        (None, Some(size)) => MeshMode::Fixed(size),
-        (None, None) => MeshMode::from_config(&config),
-    };
+    let mode = super::fem::mesh_mode(
+        &mut config,
+        args.mesh.as_ref(),
+        args.size,
+        args.target_error,
+    )?;
     let mass = mass_of_design(&args.design)?;
     let (dynamics, _) = dynamics_of_design(
         &mass,

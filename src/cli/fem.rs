@@ -57,25 +57,41 @@ pub struct FemArgs {
     sizes: Vec<f64>,
 }
 
-pub fn run(args: FemArgs) -> Result<i32> {
-    let mut config = StudyConfig::load(args.config.as_deref())?;
-    if let Some(size) = args.size {
+/// The mesh mode of `--mesh`, `--size` and `--target-error` (checked), and the configuration
+/// updated with them: shared by `fem` and `cycle`.
+pub(crate) fn mesh_mode(
+    config: &mut StudyConfig,
+    mesh: Option<&PathBuf>,
+    size: Option<f64>,
+    target_error: Option<f64>,
+) -> Result<MeshMode> {
+    if let Some(size) = size {
         if !(size.is_finite() && size > 0.0) {
             bail!("--size must be a positive number of mm, got {size}");
         }
         config.fem.mesh_size_mm = size;
     }
-    if let Some(t) = args.target_error {
+    if let Some(t) = target_error {
         if !(t.is_finite() && t > 0.0 && t < 1.0) {
             bail!("--target-error must lie in (0, 1), got {t}");
         }
         config.fem.target_error = t;
     }
-    let mode = match (&args.mesh, args.size) {
+    Ok(match (mesh, size) {
         (Some(file), _) => MeshMode::User(file.clone()),
         (None, Some(size)) => MeshMode::Fixed(size),
-        (None, None) => MeshMode::from_config(&config),
-    };
+        (None, None) => MeshMode::from_config(config),
+    })
+}
+
+pub fn run(args: FemArgs) -> Result<i32> {
+    let mut config = StudyConfig::load(args.config.as_deref())?;
+    let mode = mesh_mode(
+        &mut config,
+        args.mesh.as_ref(),
+        args.size,
+        args.target_error,
+    )?;
     let force = match args.force {
         Some(f) if f.is_finite() && f > 0.0 => f,
         Some(f) => bail!("--force must be a positive number of newtons, got {f}"),
