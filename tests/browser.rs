@@ -21,6 +21,8 @@
 //! `apt-get install chromium`; otherwise the test fails and says so. Every Chromium run is
 //! killed (its whole process group) after 60 s.
 
+mod common;
+use common::copy_design;
 use std::ffi::OsString;
 use std::os::unix::fs::PermissionsExt;
 use std::os::unix::process::CommandExt;
@@ -536,16 +538,6 @@ fn the_browser_check_sees_rows_and_catches_broken_and_remote_images() {
     let png = dir.path().join("hand-made.png");
     let size = screenshot(&page, check.height, &png);
     assert!(size > 1000, "{} is {size} bytes", png.display());
-}
-
-fn copy_design(from: &Path, to: &Path, stem: &str) {
-    for ext in ["stl", "toml"] {
-        std::fs::copy(
-            from.join(format!("{stem}.{ext}")),
-            to.join(format!("{stem}.{ext}")),
-        )
-        .unwrap();
-    }
 }
 
 /// The study's page on two designs and a broken one, in Chromium.

@@ -2,18 +2,10 @@
 //! fixed 5 mm mesh: the stress criterion is applied to the numbers it reports, and the ranking
 //! puts the design that meets it first even though its peak pin force is the higher one.
 
+mod common;
+use common::copy_design;
 use std::path::Path;
 use std::process::Command;
-
-fn copy_design(from: &Path, to: &Path, stem: &str) {
-    for ext in ["stl", "toml"] {
-        std::fs::copy(
-            from.join(format!("{stem}.{ext}")),
-            to.join(format!("{stem}.{ext}")),
-        )
-        .unwrap();
-    }
-}
 
 #[test]
 fn study_runs_stage_3_and_ranks_by_the_criterion_first() {

@@ -193,6 +193,24 @@ pub fn tet10_surface(mesh: &TetMesh) -> super::Result<SurfaceMesh> {
     Ok((vertices, triangles))
 }
 
+/// Draws a nodal field of a tet10 mesh (one value per mesh node) on the mesh's boundary surface:
+/// [`tet10_surface`] then [`render_svg`].
+pub fn render_tet10_field(
+    mesh: &TetMesh,
+    values: &[f64],
+    options: &PictureOptions,
+) -> Result<String> {
+    let (vertices_mm, triangles) = tet10_surface(mesh)?;
+    render_svg(
+        &SurfaceField {
+            vertices_mm: &vertices_mm,
+            triangles: &triangles,
+            values,
+        },
+        options,
+    )
+}
+
 /// Draws `field` in two views (plan along −z, oblique) as one self-contained SVG; see the module
 /// documentation for what is drawn.
 ///

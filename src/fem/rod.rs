@@ -476,8 +476,7 @@ fn write_case_picture(
     field: &StressField,
     case: &LoadCaseResult,
 ) -> Result<()> {
-    use super::picture::{PictureOptions, SurfaceField, render_svg, tet10_surface};
-    let (vertices_mm, triangles) = tet10_surface(mesh)?;
+    use super::picture::{PictureOptions, render_tet10_field};
     let values: Vec<f64> = field
         .von_mises_averaged()
         .iter()
@@ -485,12 +484,9 @@ fn write_case_picture(
         .collect();
     let peak = case.max_von_mises_away_from_fixed_mpa;
     let label = if case.name == "fx" { "F_x" } else { "F_y" };
-    let svg = render_svg(
-        &SurfaceField {
-            vertices_mm: &vertices_mm,
-            triangles: &triangles,
-            values: &values,
-        },
+    let svg = render_tet10_field(
+        mesh,
+        &values,
         &PictureOptions {
             title: format!(
                 "von Mises stress [MPa], {label} case: {:.0} N on the crank-pin bore, small-end bore fixed",

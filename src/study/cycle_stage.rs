@@ -15,7 +15,7 @@ use crate::fem::cycle::{
     unit_solutions,
 };
 use crate::fem::material::Material;
-use crate::fem::picture::{PictureOptions, SurfaceField, render_svg, tet10_surface};
+use crate::fem::picture::{PictureOptions, render_tet10_field};
 use crate::fem::vtu::{VtuField, write_vtu};
 use crate::geometry::design::DesignMass;
 use crate::mechanism::rod_frame_cycle;
@@ -206,15 +206,11 @@ fn write_cycle_picture(
     cycle: &CycleSolution,
     record: &DesignCycle,
 ) -> Result<()> {
-    let (vertices_mm, triangles) = tet10_surface(mesh)?;
     let values: Vec<f64> = cycle.max_von_mises_pa.iter().map(|v| v * 1e-6).collect();
     let peak = record.max_von_mises_over_cycle_mpa;
-    let svg = render_svg(
-        &SurfaceField {
-            vertices_mm: &vertices_mm,
-            triangles: &triangles,
-            values: &values,
-        },
+    let svg = render_tet10_field(
+        mesh,
+        &values,
         &PictureOptions {
             title: format!(
                 "max von Mises over one revolution [MPa] (inertia relief, {:.0} rad/s)",
