@@ -12,19 +12,31 @@
 //!   counters and caps;
 //! - [`free_run`]: scene `free` (thesis ch. 4): the reduction-method equation of motion, its exact
 //!   energy-integral reference, the multibody DAE forms and the work–precision sweep;
-//! - [`fem`]: stage 3, linear elasticity with 10-node tetrahedra (gmsh mesh, faer Cholesky),
-//!   von Mises under F_x and F_y;
-//! - [`study`]: running the stages over every design of a folder;
+//! - [`fem`]: the mathematics of stage 3 and the cycle: linear elasticity with 10-node tetrahedra
+//!   (faer Cholesky), von Mises under F_x and F_y, recovery, error estimates, the adaptive loop,
+//!   inertia-relief unit cases; it returns fields and opens no file;
+//! - [`stages`]: the spine of a design study, one function per stage from a loaded design and
+//!   settings to a typed record (mass, dynamics, fem, cycle), writing nothing;
+//! - [`study`]: running the stages over every design of a folder (cache, shards, merge, baseline);
+//! - [`report`]: everything that writes: tables, ranking, Pareto front, index page, plots, VTU
+//!   field files, stress pictures;
+//! - [`mesher`]: the gmsh adapter (the Python mesher as a subprocess, the hand-off files), behind
+//!   the small trait the adaptive loop calls;
+//! - [`config`]: the study's settings (`rodstudy.toml`);
 //! - [`python_env`]: the project-local Python environment the `pipeline/` scripts run in;
 //! - [`bench`]: benchmarks, reported as ratios against a reference run;
 //! - [`cli`]: the command-line interface the binary is a thin front over.
 
 pub mod bench;
 pub mod cli;
+pub mod config;
 pub mod fem;
 pub mod free_run;
 pub mod geometry;
 pub mod integrators;
 pub mod mechanism;
+pub mod mesher;
 pub mod python_env;
+pub mod report;
+pub mod stages;
 pub mod study;

@@ -4,7 +4,7 @@
 
 use rodstudy::geometry::design::mass_of_design;
 use rodstudy::mechanism::{DrivenScene, Method, TABLE_5_1};
-use rodstudy::study::dynamics_stage::dynamics_of_design;
+use rodstudy::stages::dynamics::dynamics;
 use std::path::PathBuf;
 
 fn design(n: u8) -> PathBuf {
@@ -81,8 +81,7 @@ fn committed_designs_have_the_calibrated_properties() {
 fn committed_designs_reproduce_the_thesis_peak_forces() {
     for row in TABLE_5_1 {
         let d = mass_of_design(&design(row.design)).unwrap();
-        let (dyn_, _) =
-            dynamics_of_design(&d, &DrivenScene::default(), true, Method::ClosedForm).unwrap();
+        let (dyn_, _) = dynamics(&d, &DrivenScene::default(), true, Method::ClosedForm).unwrap();
         let err = (dyn_.peak_pin_force_n - row.peak_force_n) / row.peak_force_n;
         if row.l1_m.is_some() {
             // measured within 4e-6 of the thesis' (rounded) peaks

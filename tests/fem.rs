@@ -8,14 +8,15 @@ use nalgebra::{DMatrix, SymmetricEigen};
 use rodstudy::fem::boundary::boundary_faces;
 use rodstudy::fem::element::{corner_volume, element_stiffness, element_volume};
 use rodstudy::fem::mesh::structured::{TwoEyePlate, box_tet10, two_eye_plate};
-use rodstudy::fem::mesh::{convert_mesh, mesh_stl, read_rodmesh, write_rodmesh};
 use rodstudy::fem::quadrature::{TET4, TET14};
+use rodstudy::fem::refinement::refinement_study;
 use rodstudy::fem::rod::solve_rod_fields;
 use rodstudy::fem::shape::TET10_EDGES;
 use rodstudy::fem::stress::stress_field;
-use rodstudy::fem::study::refinement_study;
-use rodstudy::fem::vtu::{VtuField, write_vtu};
 use rodstudy::fem::*;
+use rodstudy::mesher::{convert_mesh, mesh_stl, read_rodmesh, write_rodmesh};
+use rodstudy::report::fields::write_fem_fields;
+use rodstudy::report::vtu::{VtuField, write_vtu};
 
 // ---------------------------------------------------------------------------------------------
 // helpers
@@ -358,14 +359,13 @@ fn plate_bores_resultant_and_reaction_balance() {
             ..Default::default()
         })
         .unwrap();
-        let opts = RodOptions {
-            vtu_dir: Some(dir.path().to_path_buf()),
-            vtu_stem: Some(format!("plate{curved}")),
-            ..Default::default()
-        };
+        let opts = RodOptions::default();
         let sol =
             solve_rod_fields(&mesh, &Material::STEEL, &BoreSpec::default(), 7500.0, &opts).unwrap();
-        let r = &sol.result;
+        // the report writes the fields: fem/ opens no file
+        let mut r = sol.result.clone();
+        write_fem_fields(&mut r, &sol, &mesh, dir.path(), &format!("plate{curved}")).unwrap();
+        let r = &r;
         assert_eq!(r.curved_elements > 0, curved);
         assert!(
             (r.loaded_bore.radius_mm - 25.0).abs() < 1e-9,

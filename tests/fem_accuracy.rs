@@ -7,11 +7,13 @@
 //! tetra10 meshes of the exact OpenCASCADE geometry, refined at the fillets, extrapolated).
 
 use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
+use rodstudy::config::StudyConfig;
 use rodstudy::geometry::primitives::{binary_stl, to_soup, transformed};
 use rodstudy::geometry::stl_file::read_stl_file;
 use rodstudy::geometry::weld::weld;
-use rodstudy::study::config::StudyConfig;
-use rodstudy::study::fem_stage::{DesignFem, MeshMode, fem_of_design};
+use rodstudy::stages;
+use rodstudy::stages::fem::{AdaptiveMeshing, MeshMode};
+use rodstudy::stages::records::DesignFem;
 use std::path::Path;
 
 fn root() -> &'static Path {
@@ -51,15 +53,11 @@ fn variant(
 
 fn fem(dir: &Path, name: &str, config: &StudyConfig, mode: &MeshMode) -> DesignFem {
     let work = dir.join(format!("work-{name}"));
-    fem_of_design(
-        &dir.join(format!("{name}.stl")),
-        7500.0,
-        config,
-        &work,
-        &work.join("vtu"),
-        mode,
-    )
-    .unwrap_or_else(|e| panic!("{name}: {e:#}"))
+    let design = stages::mass::load(&dir.join(format!("{name}.stl")))
+        .unwrap_or_else(|e| panic!("{name}: {e:#}"));
+    stages::fem::fem(&design, 7500.0, config, &work, mode)
+        .unwrap_or_else(|e| panic!("{name}: {e:#}"))
+        .record
 }
 
 #[test]
@@ -157,15 +155,16 @@ fn adaptive_peak_reaches_the_converged_reference_of_the_fillet_rod() {
     assert_eq!(config.fem.target_error, 0.03);
     let force = data["force_n"].as_f64().unwrap();
     let work = dir.path().join("work");
-    let r = fem_of_design(
-        &stl,
+    let design = stages::mass::load(&stl).unwrap();
+    let r = stages::fem::fem(
+        &design,
         force,
         &config,
         &work,
-        &work.join("vtu"),
-        &MeshMode::Adaptive,
+        &MeshMode::Adaptive(AdaptiveMeshing::new(&config.fem, config.fem.target_error)),
     )
-    .unwrap();
+    .unwrap()
+    .record;
     let h: Vec<f64> = data["near_size_mm"]
         .as_array()
         .unwrap()

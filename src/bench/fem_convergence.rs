@@ -9,8 +9,8 @@
 //! table. Writes `convergence.md`, `convergence.csv`, `convergence.json` and `convergence.svg`
 //! (error against wall time, log–log) into the output folder.
 
-use crate::study::atomic_write::write_atomic;
-use crate::study::plots::{Scale, Series, line_chart};
+use crate::report::atomic_write::write_atomic;
+use crate::report::plots::{Scale, Series, line_chart};
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};

@@ -1,9 +1,9 @@
 //! `rodstudy bench mass [--triangles N] [--repeats R] [--json]`
 
 use crate::bench::mass::bench_mass;
-use crate::geometry::design::mass_of_design;
 use crate::mechanism::{DrivenScene, MechanismParams, RodInertia, bench_driven};
-use crate::study::dynamics_stage::{mechanism_for, rod_inertia};
+use crate::stages;
+use crate::stages::dynamics::{mechanism_for, rod_inertia};
 use anyhow::Result;
 use clap::Subcommand;
 use std::path::PathBuf;
@@ -95,7 +95,7 @@ pub fn run(command: BenchCommand) -> Result<i32> {
         } => {
             let (name, params, rod) = match &design {
                 Some(path) => {
-                    let m = mass_of_design(path)?;
+                    let m = stages::mass::mass(&stages::mass::load(path)?)?;
                     (m.design.clone(), mechanism_for(&m, true), rod_inertia(&m))
                 }
                 None => (

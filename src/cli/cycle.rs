@@ -2,12 +2,12 @@
 //! [--out DIR]`: stress over one crank revolution with inertia relief, and the fatigue safety
 //! factor, on the mesh stage 3 ends on.
 
-use crate::geometry::design::mass_of_design;
+use super::mesh_args::MeshArgs;
+use crate::config::StudyConfig;
 use crate::mechanism::Method;
-use crate::study::config::StudyConfig;
-use crate::study::cycle_stage::{DesignCycle, cycle_of_design};
-use crate::study::dynamics_stage::dynamics_of_design;
-use crate::study::fem_stage::fem_of_design_with_mesh;
+use crate::report::fields::{write_cycle_fields, write_fem_fields};
+use crate::stages;
+use crate::stages::records::DesignCycle;
 use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
@@ -16,16 +16,9 @@ use std::path::PathBuf;
 pub struct CycleArgs {
     /// The STL design (its sidecar gives units, pins, axis and density).
     design: PathBuf,
-    /// Use this ready tet10 volume mesh instead of meshing the STL.
-    #[arg(long)]
-    mesh: Option<PathBuf>,
-    /// One fixed mesh of this element size [mm] instead of adaptive refinement.
-    #[arg(long, conflicts_with = "target_error")]
-    size: Option<f64>,
-    /// Adaptive refinement of the static cases to this estimated error (default: the
-    /// configuration's `fem.target_error`); the cycle runs on the final mesh.
-    #[arg(long)]
-    target_error: Option<f64>,
+    /// The mesh of stage 3 the cycle runs on (the final one of adaptive refinement).
+    #[command(flatten)]
+    mesh: MeshArgs,
     /// Settings file (as for `study`).
     #[arg(long)]
     config: Option<PathBuf>,
@@ -51,29 +44,35 @@ struct CycleJson<'a> {
 }
 
 pub fn run(args: CycleArgs) -> Result<i32> {
-    let mut config = StudyConfig::load(args.config.as_deref())?;
-    let mode = super::fem::mesh_mode(
-        &mut config,
-        args.mesh.as_ref(),
-        args.size,
-        args.target_error,
-    )?;
-    let mass = mass_of_design(&args.design)?;
-    let (dynamics, _) = dynamics_of_design(
+    let config = StudyConfig::load(args.config.as_deref())?;
+    let mode = args.mesh.mode(&config)?;
+    let design = stages::mass::load(&args.design)?;
+    let mass = stages::mass::mass(&design)?;
+    let (dynamics, _) = stages::dynamics::dynamics(
         &mass,
         &config.driven_scene(),
         config.driven.gravity,
         Method::ClosedForm,
     )?;
-    let (fem, mesh) = fem_of_design_with_mesh(
-        &args.design,
+    let mut f = stages::fem::fem(
+        &design,
         dynamics.peak_pin_force_n,
         &config,
         &args.out.join("mesh"),
-        &args.out,
         &mode,
     )?;
-    let (cycle, _, _) = cycle_of_design(&mass, &mesh, &config, Some(&args.out))?;
+    write_fem_fields(
+        &mut f.record.fem,
+        &f.solution,
+        &f.mesh.mesh,
+        &args.out,
+        "fem",
+    )?;
+    let fem = f.record;
+    let mesh = f.mesh;
+    let c = stages::cycle::cycle(&mass, &mesh, &config)?;
+    let mut cycle = c.record;
+    write_cycle_fields(&mut cycle, &mesh.mesh, &c.cycle, &c.units, &args.out)?;
     // the static two-case analysis of the final mesh (assembly, factorisation, solves, stresses,
     // recovery and estimate), for the cost ratio
     let t = &fem.fem.timings;
@@ -124,7 +123,7 @@ pub fn run(args: CycleArgs) -> Result<i32> {
             cycle.stl_mass_kg
         );
         println!(
-            "time: cycle analysis {:.2} s (six unit solves, {} instants combined; {:.2} s with its files), static two-case analysis of the same mesh {:.2} s: ratio {:.2}",
+            "time: cycle analysis {:.2} s (six unit solves, {} instants combined; {:.2} s the whole stage), static two-case analysis of the same mesh {:.2} s: ratio {:.2}",
             cycle.analysis_seconds,
             cycle.instants,
             cycle.seconds,

@@ -1,10 +1,12 @@
 //! `rodstudy dynamics driven DESIGN... [--json] [--csv FILE]` and `rodstudy dynamics table-5-1`
 
 use crate::free_run::{FreeRunOptions, Method as FreeMethod, run_free};
-use crate::geometry::design::{find_stl_files, mass_of_design};
+use crate::geometry::design::find_stl_files;
 use crate::mechanism::{DrivenScene, MechanismParams, Method, table_5_1_check};
-use crate::study::dynamics_stage::{DesignDynamics, dynamics_of_design, write_history_csv};
-use crate::study::tables::dynamics_table;
+use crate::report::design_files::write_history_csv;
+use crate::report::tables::dynamics_table;
+use crate::stages;
+use crate::stages::records::DesignDynamics;
 use anyhow::Result;
 use clap::{Args, Subcommand, ValueEnum};
 use rayon::prelude::*;
@@ -192,7 +194,7 @@ fn free(args: FreeArgs) -> Result<i32> {
         for k in 0..run.t.len() {
             w.write_record([run.t[k], run.phi[k], run.omega[k]].map(|v| format!("{v:.15e}")))?;
         }
-        crate::study::atomic_write::write_atomic(path, &w.into_inner()?)?;
+        crate::report::atomic_write::write_atomic(path, &w.into_inner()?)?;
     }
     Ok(0)
 }
@@ -221,7 +223,9 @@ fn driven(args: DrivenArgs) -> Result<i32> {
     let outcomes: Vec<_> = files
         .par_iter()
         .map(|f| {
-            mass_of_design(f).and_then(|m| dynamics_of_design(&m, &scene, !args.no_gravity, method))
+            stages::mass::load(f)
+                .and_then(|d| stages::mass::mass(&d))
+                .and_then(|m| stages::dynamics::dynamics(&m, &scene, !args.no_gravity, method))
         })
         .collect();
     let ok: Vec<&DesignDynamics> = outcomes
@@ -238,7 +242,7 @@ fn driven(args: DrivenArgs) -> Result<i32> {
         for (summary, run) in outcomes.iter().filter_map(|o| o.as_ref().ok()) {
             write_history_csv(&mut w, &summary.design, run)?;
         }
-        crate::study::atomic_write::write_atomic(path, &w.into_inner()?)?;
+        crate::report::atomic_write::write_atomic(path, &w.into_inner()?)?;
         eprintln!("wrote {}", path.display());
     }
     let failed: Vec<_> = outcomes.iter().filter_map(|o| o.as_ref().err()).collect();

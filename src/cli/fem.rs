@@ -1,14 +1,12 @@
 //! `rodstudy fem DESIGN [--mesh FILE] [--size MM] [--force N] [--json] [--out DIR]
 //! [--refine 8,5,3.5]`
 
-use crate::fem::study::refinement_study_stl;
-use crate::fem::{Material, RodOptions};
-use crate::geometry::design::mass_of_design;
+use super::mesh_args::MeshArgs;
+use crate::config::StudyConfig;
 use crate::mechanism::Method;
-use crate::python_env::{pipeline_script, python};
-use crate::study::config::StudyConfig;
-use crate::study::dynamics_stage::dynamics_of_design;
-use crate::study::fem_stage::{DesignFem, MESHER, MeshMode, fem_of_design, rod_frame_surface};
+use crate::stages;
+use crate::stages::fem::MeshMode;
+use crate::stages::records::{DesignFem, LoadedDesign};
 use anyhow::{Result, bail};
 use clap::Args;
 use std::path::PathBuf;
@@ -17,18 +15,8 @@ use std::path::PathBuf;
 pub struct FemArgs {
     /// The STL design (its sidecar gives units, pins and axis).
     design: PathBuf,
-    /// Use this ready volume mesh (gmsh .msh, Abaqus/CalculiX .inp, VTU, Nastran .bdf; tet10)
-    /// as it is, instead of meshing the STL.
-    #[arg(long)]
-    mesh: Option<PathBuf>,
-    /// One fixed mesh of this element size [mm] (the thesis' setting is 5), instead of adaptive
-    /// refinement.
-    #[arg(long, conflicts_with = "target_error")]
-    size: Option<f64>,
-    /// Refine adaptively until the estimated relative error of each case's judged peak is at
-    /// most this (default: `fem.target_error` of the configuration, 0.03).
-    #[arg(long)]
-    target_error: Option<f64>,
+    #[command(flatten)]
+    mesh: MeshArgs,
     /// Load magnitude [N] of both cases (default: the design's peak pin force).
     #[arg(long)]
     force: Option<f64>,
@@ -57,74 +45,46 @@ pub struct FemArgs {
     sizes: Vec<f64>,
 }
 
-/// The mesh mode of `--mesh`, `--size` and `--target-error` (checked), and the configuration
-/// updated with them: shared by `fem` and `cycle`.
-pub(crate) fn mesh_mode(
-    config: &mut StudyConfig,
-    mesh: Option<&PathBuf>,
-    size: Option<f64>,
-    target_error: Option<f64>,
-) -> Result<MeshMode> {
-    if let Some(size) = size {
-        if !(size.is_finite() && size > 0.0) {
-            bail!("--size must be a positive number of mm, got {size}");
-        }
-        config.fem.mesh_size_mm = size;
-    }
-    if let Some(t) = target_error {
-        if !(t.is_finite() && t > 0.0 && t < 1.0) {
-            bail!("--target-error must lie in (0, 1), got {t}");
-        }
-        config.fem.target_error = t;
-    }
-    Ok(match (mesh, size) {
-        (Some(file), _) => MeshMode::User(file.clone()),
-        (None, Some(size)) => MeshMode::Fixed(size),
-        (None, None) => MeshMode::from_config(config),
-    })
+/// The design's peak pin force (stage 2), the load of both cases unless `--force` gives one.
+pub(crate) fn peak_force(design: &LoadedDesign, config: &StudyConfig) -> Result<f64> {
+    let mass = stages::mass::mass(design)?;
+    let (dynamics, _) = stages::dynamics::dynamics(
+        &mass,
+        &config.driven_scene(),
+        config.driven.gravity,
+        Method::ClosedForm,
+    )?;
+    Ok(dynamics.peak_pin_force_n)
 }
 
 pub fn run(args: FemArgs) -> Result<i32> {
-    let mut config = StudyConfig::load(args.config.as_deref())?;
-    let mode = mesh_mode(
-        &mut config,
-        args.mesh.as_ref(),
-        args.size,
-        args.target_error,
-    )?;
+    let config = StudyConfig::load(args.config.as_deref())?;
+    let mode = args.mesh.mode(&config)?;
+    let design = stages::mass::load(&args.design)?;
     let force = match args.force {
         Some(f) if f.is_finite() && f > 0.0 => f,
         Some(f) => bail!("--force must be a positive number of newtons, got {f}"),
         None => {
-            let mass = mass_of_design(&args.design)?;
-            let (dynamics, _) = dynamics_of_design(
-                &mass,
-                &config.driven_scene(),
-                config.driven.gravity,
-                Method::ClosedForm,
-            )?;
-            eprintln!(
-                "load: the design's peak pin force, {:.1} N",
-                dynamics.peak_pin_force_n
-            );
-            dynamics.peak_pin_force_n
+            let f = peak_force(&design, &config)?;
+            eprintln!("load: the design's peak pin force, {f:.1} N");
+            f
         }
     };
     if let Some(sizes) = &args.refine {
-        return refine(&args, &config, force, sizes);
+        return refine(&args, &design, &config, force, sizes);
     }
     if args.convergence {
+        let target = match &mode {
+            MeshMode::Adaptive(a) => a.target_error,
+            _ => 0.03,
+        };
         let c = if args.replot {
             crate::bench::fem_convergence::replot(&args.out)?
         } else {
             crate::bench::fem_convergence::convergence(
                 &args.design,
                 &args.sizes,
-                if config.fem.adaptive() {
-                    config.fem.target_error
-                } else {
-                    0.03
-                },
+                target,
                 force,
                 args.config.as_deref(),
                 &args.out,
@@ -141,14 +101,15 @@ pub fn run(args: FemArgs) -> Result<i32> {
         }
         return Ok(0);
     }
-    let result = fem_of_design(
-        &args.design,
-        force,
-        &config,
-        &args.out.join("mesh"),
+    let mut outcome = stages::fem::fem(&design, force, &config, &args.out.join("mesh"), &mode)?;
+    crate::report::fields::write_fem_fields(
+        &mut outcome.record.fem,
+        &outcome.solution,
+        &outcome.mesh.mesh,
         &args.out,
-        &mode,
+        "fem",
     )?;
+    let result = outcome.record;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&FemJson::from(&result))?);
     } else {
@@ -166,8 +127,8 @@ struct FemJson<'a> {
     force_n: f64,
     fx: &'a crate::fem::LoadCaseResult,
     fy: &'a crate::fem::LoadCaseResult,
-    mesh: &'a crate::study::fem_stage::MeshSummary,
-    criterion: &'a crate::study::fem_stage::StressVerdict,
+    mesh: &'a crate::stages::records::MeshSummary,
+    criterion: &'a crate::stages::records::StressVerdict,
     fem: &'a crate::fem::FemResult,
     /// Peak resident memory of this process so far (VmHWM) [MB].
     peak_memory_mb: Option<f64>,
@@ -185,7 +146,7 @@ impl<'a> From<&'a DesignFem> for FemJson<'a> {
             mesh: &d.mesh,
             criterion: &d.criterion,
             fem: &d.fem,
-            peak_memory_mb: crate::fem::bench::peak_memory_mb(),
+            peak_memory_mb: crate::bench::fem_rod::peak_memory_mb(),
         }
     }
 }
@@ -269,28 +230,15 @@ fn print_result(d: &DesignFem) {
     }
 }
 
-fn refine(args: &FemArgs, config: &StudyConfig, force: f64, sizes: &[f64]) -> Result<i32> {
-    // meshed in the rod frame, mm, as stage 3 meshes (any units and pose)
-    let surface = rod_frame_surface(&args.design, &args.out.join("refinement"))?;
-    let bores = surface.bores();
-    let material = Material {
-        youngs_modulus_pa: config.fem.youngs_modulus_pa,
-        poisson_ratio: config.fem.poisson_ratio,
-    };
-    let study = refinement_study_stl(
-        &python()?,
-        &pipeline_script(MESHER),
-        &surface.stl,
-        sizes,
-        &args.out.join("refinement"),
-        &material,
-        &bores,
-        force,
-        &RodOptions {
-            fixed_band_m: Some(config.fem.fixed_band_mm * 1e-3),
-            ..RodOptions::default()
-        },
-    )?;
+fn refine(
+    args: &FemArgs,
+    design: &LoadedDesign,
+    config: &StudyConfig,
+    force: f64,
+    sizes: &[f64],
+) -> Result<i32> {
+    let study =
+        stages::fem::fem_refinement(design, force, config, &args.out.join("refinement"), sizes)?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&study)?);
         return Ok(0);

@@ -2,8 +2,8 @@
 //! the free run (thesis ch. 4) against the exact energy-integral reference.
 
 use crate::free_run::{FreeScene, Method, SweepConfig, WorkPrecision, work_precision_sweep};
-use crate::study::atomic_write::write_atomic;
-use crate::study::plots::{Scale, Series, line_chart};
+use crate::report::atomic_write::write_atomic;
+use crate::report::plots::{Scale, Series, line_chart};
 use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;

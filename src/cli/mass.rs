@@ -1,7 +1,9 @@
 //! `rodstudy mass PATH... [--json]`
 
-use crate::geometry::design::{DesignMass, find_stl_files, mass_of_solid};
-use crate::study::tables::mass_table;
+use crate::geometry::design::find_stl_files;
+use crate::report::tables::mass_table;
+use crate::stages;
+use crate::stages::records::DesignMass;
 use anyhow::Result;
 use clap::Args;
 use rayon::prelude::*;
@@ -22,7 +24,7 @@ pub fn run(args: MassArgs) -> Result<i32> {
     let results: Vec<(PathBuf, Result<DesignMass>)> = files
         .into_par_iter()
         .map(|f| {
-            let r = mass_of_solid(&f);
+            let r = stages::mass::load(&f).map(|d| stages::mass::mass_of_solid(&d));
             (f, r)
         })
         .collect();

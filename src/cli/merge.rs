@@ -1,8 +1,8 @@
 //! `rodstudy merge SHARD_DIR... --out DIR`: the reports of a one-machine study from the shards of
 //! `study --shard K/N`.
 
+use crate::report::write_reports;
 use crate::study::merge::merge_shards;
-use crate::study::write_reports;
 use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;

@@ -11,6 +11,7 @@ mod fem;
 mod integrators;
 mod mass;
 mod merge;
+mod mesh_args;
 mod pipeline;
 mod study;
 mod sweep;

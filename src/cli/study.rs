@@ -1,11 +1,12 @@
 //! `rodstudy study [--designs DIR] [--out DIR] [--config FILE] [--jobs N] [--no-cache]
 //! [--update-baseline]`
 
-use crate::study::atomic_write::write_atomic;
+use crate::config::StudyConfig;
+use crate::report::atomic_write::write_atomic;
+use crate::report::tables::{dynamics_table, mass_table};
+use crate::report::write_reports;
 use crate::study::baseline::{Baseline, read_results};
-use crate::study::config::StudyConfig;
-use crate::study::tables::{dynamics_table, mass_table};
-use crate::study::{Progress, StudyOptions, run_study, write_reports};
+use crate::study::{Progress, StudyOptions, run_study};
 use anyhow::Result;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};

@@ -46,9 +46,7 @@ use super::error::{FemError, Result};
 use super::material::Material;
 use super::mesh::{TetMesh, dist};
 use super::recovery::node_elements;
-use super::rod::{
-    AdaptiveStep, DEFAULT_FIXED_BAND_M, RodOptions, RodSolution, solve_rod_fields, write_rod_vtus,
-};
+use super::rod::{AdaptiveStep, DEFAULT_FIXED_BAND_M, RodOptions, RodSolution, solve_rod_fields};
 use super::shape::TET10_EDGES;
 
 /// Settings of the adaptive loop.
@@ -93,6 +91,20 @@ pub struct MeshAsk<'a> {
     pub size_m: f64,
     /// The previous mesh and the size wanted at each of its nodes, m.
     pub size_map: Option<(&'a TetMesh, &'a [f64])>,
+}
+
+/// What makes the meshes of the loop: the first (uniform) and each one from a size map. The gmsh
+/// adapter implements it ([`crate::mesher::GmshRodMesher`]); so does any closure
+/// `FnMut(&MeshAsk) -> Result<(TetMesh, seconds)>`, e.g. an in-memory mesher in a test.
+pub trait Mesher {
+    /// The mesh asked for, and the seconds it took to make.
+    fn mesh(&mut self, ask: &MeshAsk<'_>) -> Result<(TetMesh, f64)>;
+}
+
+impl<F: FnMut(&MeshAsk<'_>) -> Result<(TetMesh, f64)>> Mesher for F {
+    fn mesh(&mut self, ask: &MeshAsk<'_>) -> Result<(TetMesh, f64)> {
+        self(ask)
+    }
 }
 
 /// Why the loop stopped.
@@ -222,7 +234,7 @@ fn peak_estimate(h: &PeakHistory, bound: f64, order: f64) -> (f64, bool, f64, f6
 /// 0 for none). The band around the fixed bore is `rod.fixed_band_m` (default
 /// [`DEFAULT_FIXED_BAND_M`]).
 pub fn adaptive_rod(
-    mut mesher: impl FnMut(&MeshAsk<'_>) -> Result<(TetMesh, f64)>,
+    mesher: &mut impl Mesher,
     material: &Material,
     bores: &BoreSpec,
     force_n: f64,
@@ -245,7 +257,6 @@ pub fn adaptive_rod(
     let band = rod.fixed_band_m.unwrap_or(DEFAULT_FIXED_BAND_M);
     let rod_opts = RodOptions {
         fixed_band_m: Some(band),
-        vtu_dir: None,
         ..rod.clone()
     };
     let tau = opts.target_error_rel;
@@ -264,7 +275,7 @@ pub fn adaptive_rod(
             size_m: opts.initial_size_m,
             size_map: next_sizes.as_ref().map(|(m, s)| (m, s.as_slice())),
         };
-        let (mesh, secs) = mesher(&ask)?;
+        let (mesh, secs) = mesher.mesh(&ask)?;
         mesh_s += secs;
         let last = iteration + 1 >= opts.max_iterations;
         let sol = solve_rod_fields(&mesh, material, bores, force_n, &rod_opts)?;
@@ -365,14 +376,6 @@ pub fn adaptive_rod(
             {
                 case.estimated_error_rel = estimates[c];
                 case.adaptive = steps[c].clone();
-            }
-            if let Some(dir) = &rod.vtu_dir {
-                write_rod_vtus(
-                    &mut solution,
-                    &mesh,
-                    dir,
-                    rod.vtu_stem.as_deref().unwrap_or("rod"),
-                )?;
             }
             solution.result.total_s = t_all.elapsed().as_secs_f64();
             return Ok(AdaptiveSolution {

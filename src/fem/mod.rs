@@ -5,7 +5,9 @@
 //! boundary faces → bores found on the geometry ([`bores`]) → consistent nodal forces of a uniform
 //! bore traction ([`load`]) → parallel assembly ([`assembly`]) → sparse Cholesky (faer, [`solver`]),
 //! both load cases (F_x, F_y) from one factorisation → stresses at the element nodes, unaveraged and
-//! nodally averaged ([`stress`]) → figures ([`rod::FemResult`]) and ParaView files ([`vtu`]).
+//! nodally averaged ([`stress`]) → figures ([`rod::FemResult`]) and fields ([`rod::RodSolution`]);
+//! the meshes come from [`crate::mesher`], the ParaView files and pictures are written by
+//! [`crate::report`]: nothing here opens a file.
 //!
 //! Cost: the sparse Cholesky factorisation dominates (≈ 75 % of the analysis of a rod at 5 mm,
 //! ~130 kDOF, factor ≈ 75 M entries); the symbolic analysis ([`solver::SymbolicFactor`]) is kept and
@@ -22,7 +24,6 @@
 
 pub mod adapt;
 pub mod assembly;
-pub mod bench;
 pub mod body_force;
 pub mod bores;
 pub mod boundary;
@@ -38,13 +39,12 @@ pub mod mesh;
 pub mod picture;
 pub mod quadrature;
 pub mod recovery;
+pub mod refinement;
 pub mod rod;
 pub mod shape;
 pub mod solver;
 pub mod statics;
 pub mod stress;
-pub mod study;
-pub mod vtu;
 
 pub use bores::{BoreRole, BoreSpec, BoreSurface};
 pub use element::QuadratureChoice;

@@ -26,7 +26,6 @@ use super::stress::{
     StressField, displacement_magnitudes, nodes_away_from, nodes_away_from_segments, peak_nodal,
     peak_unaveraged, stress_field,
 };
-use super::vtu::{VtuField, write_vtu};
 
 /// The default band around the fixed bore excluded from the judged stress measure: 6 mm.
 pub const DEFAULT_FIXED_BAND_M: f64 = 6e-3;
@@ -51,10 +50,6 @@ pub struct RodOptions {
     /// [`DEFAULT_SINGULAR_BAND_M`]).
     #[serde(default)]
     pub singular_band_m: Option<f64>,
-    /// Write ParaView files `<vtu_dir>/<vtu_stem>_fx.vtu` and `_fy.vtu` when set.
-    pub vtu_dir: Option<PathBuf>,
-    /// Base name of the VTU files (default "rod").
-    pub vtu_stem: Option<String>,
 }
 
 /// Results of one load case. Stresses in MPa, lengths in mm, forces in N.
@@ -411,7 +406,7 @@ pub fn solve_rod_fields(
     let [e0, e1]: [ErrorEstimate; 2] = estimates
         .try_into()
         .map_err(|_| FemError::Check("two cases".into()))?;
-    let mut solution = RodSolution {
+    let solution = RodSolution {
         result,
         displacements: [d0, d1],
         stresses: [s0, s1],
@@ -421,185 +416,5 @@ pub fn solve_rod_fields(
         singularity_floor_m: chase_floor,
         estimates: [e0, e1],
     };
-    if let Some(dir) = &options.vtu_dir {
-        write_rod_vtus(
-            &mut solution,
-            mesh,
-            dir,
-            options.vtu_stem.as_deref().unwrap_or("rod"),
-        )?;
-    }
     Ok(solution)
-}
-
-/// Writes the ParaView files `<dir>/<stem>_fx.vtu` and `_fy.vtu` of a solution on `mesh`, and the
-/// pictures of the von Mises field `<dir>/von_mises_fx.svg` and `_fy.svg`, and records their paths
-/// in its figures.
-pub fn write_rod_vtus(
-    solution: &mut RodSolution,
-    mesh: &TetMesh,
-    dir: &std::path::Path,
-    stem: &str,
-) -> Result<()> {
-    std::fs::create_dir_all(dir).map_err(|e| FemError::io(dir, e))?;
-    for c in 0..2 {
-        let case = if c == 0 {
-            &mut solution.result.fx
-        } else {
-            &mut solution.result.fy
-        };
-        let path = dir.join(format!("{stem}_{}.vtu", case.name));
-        write_case_vtu(
-            &path,
-            mesh,
-            &solution.displacements[c],
-            &solution.stresses[c],
-            &solution.estimates[c],
-            &solution.fixed,
-            &solution.loaded,
-            &solution.away_from_fixed,
-        )?;
-        case.vtu = Some(path);
-        let picture = dir.join(format!("von_mises_{}.svg", case.name));
-        write_case_picture(&picture, mesh, &solution.stresses[c], case)?;
-        case.picture = Some(picture);
-    }
-    Ok(())
-}
-
-/// The picture of one case: the nodally averaged von Mises stress on the surface, the colour
-/// scale up to the judged peak (away from the fixed bore and the singular edges; the singular
-/// peaks above it get the scale's "over" colour) and that peak marked.
-fn write_case_picture(
-    path: &std::path::Path,
-    mesh: &TetMesh,
-    field: &StressField,
-    case: &LoadCaseResult,
-) -> Result<()> {
-    use super::picture::{PictureOptions, render_tet10_field};
-    let values: Vec<f64> = field
-        .von_mises_averaged()
-        .iter()
-        .map(|v| v * 1e-6)
-        .collect();
-    let peak = case.max_von_mises_away_from_fixed_mpa;
-    let label = if case.name == "fx" { "F_x" } else { "F_y" };
-    let svg = render_tet10_field(
-        mesh,
-        &values,
-        &PictureOptions {
-            title: format!(
-                "von Mises stress [MPa], {label} case: {:.0} N on the crank-pin bore, small-end bore fixed",
-                case.force_n
-            ),
-            unit: "MPa".into(),
-            range: [0.0, if peak > 0.0 { peak } else { 1.0 }],
-            marker_mm: Some(case.max_von_mises_away_from_fixed_at_mm),
-            marker_label: format!(
-                "peak {peak:.1} MPa ± {:.1} %",
-                100.0 * case.estimated_error_rel
-            ),
-            width_px: 960,
-        },
-    )
-    .map_err(|e| FemError::Check(format!("{}: picture: {e:#}", path.display())))?;
-    let tmp = path.with_extension("svg.tmp");
-    std::fs::write(&tmp, svg).map_err(|e| FemError::io(&tmp, e))?;
-    std::fs::rename(&tmp, path).map_err(|e| FemError::io(path, e))?;
-    Ok(())
-}
-
-#[allow(clippy::too_many_arguments)]
-fn write_case_vtu(
-    path: &std::path::Path,
-    mesh: &TetMesh,
-    u: &[f64],
-    field: &StressField,
-    estimate: &ErrorEstimate,
-    fixed: &BoreSurface,
-    loaded: &BoreSurface,
-    away: &[bool],
-) -> Result<()> {
-    let u_mm: Vec<f64> = u.iter().map(|v| v * 1e3).collect();
-    let vm_mpa: Vec<f64> = field
-        .von_mises_averaged()
-        .iter()
-        .map(|v| v * 1e-6)
-        .collect();
-    let vm_rec_mpa: Vec<f64> = estimate
-        .recovered_von_mises_pa
-        .iter()
-        .map(|v| v * 1e-6)
-        .collect();
-    let err_mpa: Vec<f64> = estimate
-        .element_von_mises_error_pa
-        .iter()
-        .map(|v| v * 1e-6)
-        .collect();
-    let sig_mpa: Vec<f64> = field
-        .averaged
-        .iter()
-        .flat_map(|s| s.map(|v| v * 1e-6))
-        .collect();
-    let mut set = vec![0.0; mesh.n_nodes()];
-    for &n in &loaded.nodes {
-        set[n] = 1.0;
-    }
-    for &n in &fixed.nodes {
-        set[n] = 2.0;
-    }
-    let near: Vec<f64> = away.iter().map(|a| if *a { 0.0 } else { 1.0 }).collect();
-    let cell_vm: Vec<f64> = field
-        .von_mises_element_max()
-        .iter()
-        .map(|v| v * 1e-6)
-        .collect();
-    write_vtu(
-        path,
-        mesh,
-        &[
-            VtuField {
-                name: "displacement_mm",
-                components: 3,
-                data: &u_mm,
-            },
-            VtuField {
-                name: "von_mises_averaged_MPa",
-                components: 1,
-                data: &vm_mpa,
-            },
-            VtuField {
-                name: "von_mises_recovered_MPa",
-                components: 1,
-                data: &vm_rec_mpa,
-            },
-            VtuField {
-                name: "stress_averaged_MPa",
-                components: 6,
-                data: &sig_mpa,
-            },
-            VtuField {
-                name: "bore_set_1loaded_2fixed",
-                components: 1,
-                data: &set,
-            },
-            VtuField {
-                name: "near_fixed_band",
-                components: 1,
-                data: &near,
-            },
-        ],
-        &[
-            VtuField {
-                name: "von_mises_max_unaveraged_MPa",
-                components: 1,
-                data: &cell_vm,
-            },
-            VtuField {
-                name: "von_mises_error_indicator_MPa",
-                components: 1,
-                data: &err_mpa,
-            },
-        ],
-    )
 }

@@ -117,15 +117,25 @@ pub fn mass_of_design(stl: &Path) -> Result<DesignMass> {
 /// written as JSON `null`, with a warning saying why, when the pins do not sit in bores.
 /// File and surface defects are still errors.
 pub fn mass_of_solid(stl: &Path) -> Result<DesignMass> {
-    let d = load_design(stl)?;
-    match rod_record(&d, stl) {
-        Ok(r) => Ok(r),
+    Ok(solid_mass(&load_design(stl)?))
+}
+
+/// Stage 1 of a loaded design: the bore check and the record ([`mass_of_design`]).
+pub fn rod_mass(d: &LoadedDesign) -> Result<DesignMass> {
+    rod_record(d, &d.file)
+}
+
+/// [`mass_of_solid`] of a loaded design.
+pub fn solid_mass(d: &LoadedDesign) -> DesignMass {
+    let stl = d.file.as_path();
+    match rod_record(d, stl) {
+        Ok(r) => r,
         Err(e) => {
-            let mut r = record(&d, stl, None);
+            let mut r = record(d, stl, None);
             r.warnings.push(format!(
                 "no mechanism-frame properties (l1, I_zz, I_xx, bores: null): {e:#}"
             ));
-            Ok(r)
+            r
         }
     }
 }

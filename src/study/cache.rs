@@ -5,8 +5,8 @@
 //! The key is the SHA-256 of the program version, the configuration (as JSON), the STL bytes and
 //! the sidecar bytes. Entries live in `OUT/.cache/<id>.json`, written atomically.
 
-use super::atomic_write::write_atomic;
-use super::config::StudyConfig;
+use crate::config::StudyConfig;
+use crate::report::atomic_write::write_atomic;
 use anyhow::Result;
 use serde::{Serialize, de::DeserializeOwned};
 use sha2::{Digest, Sha256};

@@ -7,14 +7,15 @@
 //! per-design files (ParaView, pictures) are copied; the pin-force histories are recomputed
 //! (closed form, milliseconds); then the reports are written as a study writes them.
 
-use super::cycle_stage::DesignCycle;
-use super::dynamics_stage::{DesignDynamics, mechanism_for, rod_inertia};
-use super::fem_stage::DesignFem;
+use super::results::{DesignResult, FailedDesign, StudyResults};
 use super::shard::{ShardRecord, check_complete};
-use super::{DesignResult, FailedDesign, StudyResults, atomic_write::write_atomic, file_safe};
+use crate::config::StudyConfig;
 use crate::geometry::design::DesignMass;
 use crate::mechanism::{DrivenResult, Method, driven_scene};
-use crate::study::config::StudyConfig;
+use crate::report::atomic_write::write_atomic;
+use crate::report::file_safe;
+use crate::stages::dynamics::{mechanism_for, rod_inertia};
+use crate::stages::records::{DesignCycle, DesignDynamics, DesignFem};
 use anyhow::{Context, Result, bail};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};

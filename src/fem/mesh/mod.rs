@@ -1,16 +1,9 @@
-//! The quadratic tetrahedral mesh (SI: metres) and where it comes from: the `.rodmesh` hand-off file
-//! ([`rodmesh`]), the Python mesher `pipeline/mesh_rod.py` ([`gmsh`]) and structured meshes made in
-//! Rust for verification ([`structured`]).
+//! The quadratic tetrahedral mesh (SI: metres), and structured meshes made in Rust for
+//! verification ([`structured`]); meshes of a rod come from [`crate::mesher`].
 //!
 //! Element node order: VTK's tetra10 (see [`crate::fem::shape`]).
 
-pub mod gmsh;
-pub mod rodmesh;
-pub mod size_field;
 pub mod structured;
-
-pub use gmsh::{MeshReport, MeshRequest, MeshedRod, convert_mesh, mesh_stl, mesh_stl_with};
-pub use rodmesh::{read_rodmesh, write_rodmesh};
 
 use super::element::{ElementCoords, QuadratureChoice, check_jacobian, is_straight};
 use super::error::{FemError, Result};

@@ -6,8 +6,9 @@
 //!
 //! Self-contained for `file://`: relative links only, no scripts, no fonts or styles fetched.
 
+use super::file_safe;
 use super::ranking::{self, RankRow, Status, escape};
-use super::{StudyResults, file_safe};
+use crate::study::results::StudyResults;
 use std::fmt::Write as _;
 use std::path::Path;
 

@@ -6,7 +6,7 @@
 //! a dominates b ⇔ a is no worse than b on every objective and better on at least one
 //! (K. Deb, *Multi-Objective Optimization using Evolutionary Algorithms*, 2001, §2.4).
 
-use super::StudyResults;
+use crate::study::results::StudyResults;
 use serde::Serialize;
 
 /// One design's objectives and whether it is on the front.

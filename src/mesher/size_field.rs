@@ -9,7 +9,7 @@
 use std::io::Write;
 use std::path::Path;
 
-use super::TetMesh;
+use crate::fem::TetMesh;
 use crate::fem::error::{FemError, Result};
 
 /// Writes the size map `sizes` (one per mesh node, only corner nodes are read) of `mesh` to

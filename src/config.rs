@@ -277,6 +277,16 @@ impl StudyConfig {
     }
 }
 
+impl From<&FemConfig> for crate::fem::Material {
+    /// The elastic constants of stage 3 and the cycle.
+    fn from(c: &FemConfig) -> Self {
+        crate::fem::Material {
+            youngs_modulus_pa: c.youngs_modulus_pa,
+            poisson_ratio: c.poisson_ratio,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

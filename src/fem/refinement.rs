@@ -2,7 +2,6 @@
 //! converges (the maximum away from the fixed bore) and which does not (the peak at the fixed edge,
 //! a singularity).
 
-use std::path::Path;
 use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
@@ -10,7 +9,7 @@ use serde::{Deserialize, Serialize};
 use super::bores::BoreSpec;
 use super::error::{FemError, Result};
 use super::material::Material;
-use super::mesh::{TetMesh, mesh_stl};
+use super::mesh::TetMesh;
 use super::rod::{LoadCaseResult, RodOptions, solve_rod};
 use super::statics::Timings;
 
@@ -128,37 +127,4 @@ pub fn refinement_study(
         fixed_band_mm: band * 1e3,
         levels,
     })
-}
-
-/// [`refinement_study`] with meshes made from `stl` by `pipeline/mesh_rod.py` (into `out_dir/<size>mm/`).
-#[allow(clippy::too_many_arguments)]
-pub fn refinement_study_stl(
-    python: &Path,
-    script: &Path,
-    stl: &Path,
-    sizes_mm: &[f64],
-    out_dir: &Path,
-    material: &Material,
-    bores: &BoreSpec,
-    force_n: f64,
-    options: &RodOptions,
-) -> Result<RefinementStudy> {
-    refinement_study(
-        sizes_mm,
-        |size| {
-            let t = Instant::now();
-            let m = mesh_stl(
-                python,
-                script,
-                stl,
-                size,
-                &out_dir.join(format!("{size}mm")),
-            )?;
-            Ok((m.mesh, t.elapsed().as_secs_f64()))
-        },
-        material,
-        bores,
-        force_n,
-        options,
-    )
 }

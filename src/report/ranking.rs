@@ -6,11 +6,11 @@
 //! whose FEM stage failed keeps its mass and peak force but is not ranked: it follows the ranked
 //! designs, without a rank, with the failing stage and its message as its status.
 
-use super::cycle_stage::DesignCycle;
-use super::fem_stage::DesignFem;
-use super::{DesignResult, FailedDesign, StudyResults};
 use crate::geometry::design::DesignMass;
-use crate::study::dynamics_stage::DesignDynamics;
+use crate::stages::records::DesignCycle;
+use crate::stages::records::DesignDynamics;
+use crate::stages::records::DesignFem;
+use crate::study::results::{DesignResult, FailedDesign, StudyResults};
 use anyhow::Result;
 use serde::Serialize;
 

@@ -6,11 +6,11 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::bores::BoreSpec;
-use super::error::Result;
-use super::material::Material;
-use super::mesh::{MeshReport, mesh_stl};
-use super::rod::{FemResult, RodOptions, solve_rod};
+use crate::fem::bores::BoreSpec;
+use crate::fem::error::Result;
+use crate::fem::material::Material;
+use crate::fem::rod::{FemResult, RodOptions, solve_rod};
+use crate::mesher::{MeshReport, mesh_stl};
 
 /// What [`bench_rod`] measures.
 #[derive(Clone, Debug, Serialize, Deserialize)]

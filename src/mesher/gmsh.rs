@@ -13,8 +13,8 @@ use std::time::{Duration, Instant};
 
 use serde::{Deserialize, Serialize};
 
-use super::TetMesh;
 use super::rodmesh::read_rodmesh;
+use crate::fem::TetMesh;
 use crate::fem::error::{FemError, Result};
 
 /// What the mesher reports (quality figures from gmsh's `getElementQualities`).

@@ -15,7 +15,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::TetMesh;
+use crate::fem::TetMesh;
 use crate::fem::error::{FemError, Result};
 
 /// Reads a `.rodmesh` file into a validated mesh in metres.

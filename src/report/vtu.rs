@@ -4,8 +4,8 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::error::{FemError, Result};
-use super::mesh::TetMesh;
+use crate::fem::TetMesh;
+use crate::fem::error::{FemError, Result};
 
 /// VTK_QUADRATIC_TETRA.
 pub const VTK_QUADRATIC_TETRA: u8 = 24;

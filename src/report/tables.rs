@@ -34,7 +34,7 @@ pub fn mass_table(designs: &[&DesignMass]) -> String {
 }
 
 /// The stage-2 table for people: the peak crank–rod pin force of each design.
-pub fn dynamics_table(designs: &[&crate::study::dynamics_stage::DesignDynamics]) -> String {
+pub fn dynamics_table(designs: &[&crate::stages::records::DesignDynamics]) -> String {
     let mut out = String::from(
         "| design | peak pin force [N] | at crank angle [°] | at t [s] | TDC formula [N] | ∂F/∂m3 [N/kg] | ∂F/∂l1 [N/mm] | ∂F/∂I_zz [N/(kg·m²)] | gravity |\n|---|---|---|---|---|---|---|---|---|\n",
     );

@@ -1,0 +1,20 @@
+//! The gmsh adapter: how a tet10 mesh is made from a rod surface, apart from the FEM mathematics.
+//!
+//! `pipeline/mesh_rod.py` (gmsh + meshio, in the project's Python environment) runs as a
+//! subprocess under a time limit ([`gmsh`]); meshes come back through the `.rodmesh` hand-off file
+//! ([`rodmesh`]); adaptive refinement hands gmsh a size map as a binary file ([`size_field`]).
+//! [`rod_mesher::GmshRodMesher`] puts these together behind [`crate::fem::adapt::Mesher`], the
+//! small trait the adaptive loop calls, so that the loop itself can be driven by an in-memory
+//! mesher in tests.
+
+pub mod gmsh;
+pub mod rod_mesher;
+pub mod rodmesh;
+pub mod size_field;
+
+pub use gmsh::{MeshReport, MeshRequest, MeshedRod, convert_mesh, mesh_stl, mesh_stl_with};
+pub use rod_mesher::GmshRodMesher;
+pub use rodmesh::{read_rodmesh, write_rodmesh};
+
+/// The mesher script in `pipeline/`.
+pub const MESHER_SCRIPT: &str = "mesh_rod.py";

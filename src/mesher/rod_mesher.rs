@@ -1,0 +1,129 @@
+//! The meshes of stage 3 from the rod-frame STL: one fixed-size mesh, or the meshes the adaptive
+//! loop asks for ([`crate::fem::adapt::Mesher`]), each in its own folder of the work directory,
+//! with gmsh's classified surface cached between them.
+
+use std::path::{Path, PathBuf};
+
+use super::gmsh::{MeshReport, MeshRequest, MeshedRod, mesh_stl, mesh_stl_with};
+use super::size_field::write_size_field;
+use crate::fem::adapt::{MeshAsk, Mesher};
+use crate::fem::error::{FemError, Result};
+use crate::fem::mesh::TetMesh;
+
+/// gmsh on one rod surface (an STL in millimetres, in the rod frame).
+pub struct GmshRodMesher {
+    python: PathBuf,
+    script: PathBuf,
+    stl: PathBuf,
+    /// Cache of gmsh's classified surface, shared by every mesh of this surface.
+    geometry: PathBuf,
+    work_dir: PathBuf,
+    /// What the design is called in progress messages.
+    label: String,
+    /// The report of the last mesh made.
+    pub last_report: Option<MeshReport>,
+}
+
+impl GmshRodMesher {
+    /// A mesher of the binary STL `stl_bytes` (written to `work_dir/rod_frame.stl`) whose meshes
+    /// go under `work_dir`; `digest` (of the STL's bytes) keys the classified-surface cache.
+    pub fn new(
+        python: &Path,
+        script: &Path,
+        stl_bytes: &[u8],
+        digest: &str,
+        work_dir: &Path,
+        label: &str,
+    ) -> Result<Self> {
+        std::fs::create_dir_all(work_dir).map_err(|e| FemError::io(work_dir, e))?;
+        let stl = work_dir.join("rod_frame.stl");
+        let tmp = work_dir.join(".rod_frame.stl.tmp");
+        std::fs::write(&tmp, stl_bytes).map_err(|e| FemError::io(&tmp, e))?;
+        std::fs::rename(&tmp, &stl).map_err(|e| FemError::io(&stl, e))?;
+        Ok(GmshRodMesher {
+            python: python.to_path_buf(),
+            script: script.to_path_buf(),
+            stl,
+            geometry: work_dir.join(format!("classified-{}.msh", &digest[..16])),
+            work_dir: work_dir.to_path_buf(),
+            label: label.to_string(),
+            last_report: None,
+        })
+    }
+
+    /// One mesh of uniform size `size_mm` (with a size field: its cap) into `dir`.
+    pub fn mesh_into(
+        &self,
+        size_mm: f64,
+        size_field: Option<&Path>,
+        dir: &Path,
+    ) -> Result<MeshedRod> {
+        mesh_stl_with(
+            &self.python,
+            &self.script,
+            &self.stl,
+            &MeshRequest {
+                size_mm,
+                size_field,
+                geometry: Some(&self.geometry),
+                name: Some("rod"),
+            },
+            dir,
+        )
+    }
+
+    /// One mesh of uniform size `size_mm` into `dir`, without the classified-surface cache (each
+    /// size classifies the surface afresh, as a refinement study on its own wants).
+    pub fn uncached(&self, size_mm: f64, dir: &Path) -> Result<MeshedRod> {
+        mesh_stl(&self.python, &self.script, &self.stl, size_mm, dir)
+    }
+
+    /// The one fixed-size mesh of stage 3 (`work_dir/fixed`).
+    pub fn fixed(&mut self, size_mm: f64) -> Result<MeshedRod> {
+        let meshed = self.mesh_into(size_mm, None, &self.work_dir.join("fixed"))?;
+        self.last_report = Some(meshed.report.clone());
+        Ok(meshed)
+    }
+}
+
+impl Mesher for GmshRodMesher {
+    /// The mesh the adaptive loop asks for, in `work_dir/adapt<iteration>`. gmsh can fail to
+    /// remesh a faceted surface coarsely where thin features meet ("overlapping facets"): a
+    /// failed mesh is asked again with all sizes × 0.8, twice at most.
+    fn mesh(&mut self, ask: &MeshAsk<'_>) -> Result<(TetMesh, f64)> {
+        let dir = self.work_dir.join(format!("adapt{}", ask.iteration));
+        std::fs::create_dir_all(&dir)
+            .map_err(|e| FemError::Mesher(format!("{}: {e}", dir.display())))?;
+        let field_path = dir.join("size_field.bin");
+        let mut scale = 1.0;
+        let mut tries = 0;
+        let meshed = loop {
+            let field = match ask.size_map {
+                Some((m, s)) => {
+                    let scaled: Vec<f64> = s.iter().map(|v| v * scale).collect();
+                    write_size_field(&field_path, m, &scaled, 1e3)?;
+                    Some(field_path.as_path())
+                }
+                None => None,
+            };
+            match self.mesh_into(ask.size_m * 1e3 * scale, field, &dir) {
+                Ok(m) => break m,
+                Err(e) if tries < 2 => {
+                    eprintln!(
+                        "{}: mesh {} failed, sizes × {:.2} next: {}",
+                        self.label,
+                        ask.iteration,
+                        0.8 * scale,
+                        e.to_string().lines().last().unwrap_or_default()
+                    );
+                    scale *= 0.8;
+                    tries += 1;
+                }
+                Err(e) => return Err(e),
+            }
+        };
+        let secs = meshed.report.seconds_wall.max(meshed.report.seconds_total);
+        self.last_report = Some(meshed.report);
+        Ok((meshed.mesh, secs))
+    }
+}

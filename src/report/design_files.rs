@@ -1,0 +1,182 @@
+//! Per-design and all-design files of stage 2 and the cycle: the pin-force history (CSV and plot),
+//! the cycle's stress history (CSV and plot), and |F_A| of all designs in one plot.
+
+use super::plots;
+use super::ranking;
+use crate::mechanism::DrivenResult;
+use crate::stages::records::DesignCycle;
+use crate::study::results::StudyResults;
+use anyhow::Result;
+use serde::Serialize;
+
+/// (id, name, pin-force history) of every design that passed stage 2, in ranking order.
+pub fn histories(results: &StudyResults) -> Vec<(String, String, &DrivenResult)> {
+    ranking::ranking(results)
+        .iter()
+        .filter_map(|r| {
+            let h = results
+                .designs
+                .iter()
+                .find(|d| d.mass.id == r.mass.id)
+                .map(|d| &d.history)
+                .or_else(|| {
+                    results
+                        .failed
+                        .iter()
+                        .find(|f| f.mass.as_ref().is_some_and(|m| m.id == r.mass.id))
+                        .and_then(|f| f.history.as_ref())
+                })?;
+            Some((r.mass.id.clone(), r.mass.design.clone(), h))
+        })
+        .collect()
+}
+
+/// The points of one history over its first crank revolution: (φ − φ₀ [°], value).
+fn first_turn(h: &DrivenResult, value: impl Fn(usize) -> f64) -> Vec<(f64, f64)> {
+    let turn = std::f64::consts::TAU;
+    (0..h.t_s.len())
+        .take_while(|&k| h.phi_rad[k] - h.phi_rad[0] <= turn + 1e-9)
+        .map(|k| ((h.phi_rad[k] - h.phi_rad[0]).to_degrees(), value(k)))
+        .collect()
+}
+
+/// One design's pin force over the first revolution: |F_A| and its components.
+pub fn design_pin_force_plot(design: &str, h: &DrivenResult) -> Result<String> {
+    let series = vec![
+        plots::Series {
+            name: "|F_A|".into(),
+            points: first_turn(h, |k| h.fa_abs_n[k]),
+        },
+        plots::Series {
+            name: "F_Ax".into(),
+            points: first_turn(h, |k| h.fa_x_n[k]),
+        },
+        plots::Series {
+            name: "F_Ay".into(),
+            points: first_turn(h, |k| h.fa_y_n[k]),
+        },
+    ];
+    plots::line_chart(
+        &format!("{design}: crank–rod pin force (φ = 40πt, gravity on)"),
+        "crank angle φ [°] (0 = top dead centre)",
+        "force by the crank on the rod at A [N] (global frame)",
+        &series,
+        plots::Scale::Linear,
+        plots::Scale::Linear,
+    )
+}
+
+/// |F_A| over the first crank revolution, all designs in one plot.
+pub fn pin_force_plot(histories: &[(String, String, &DrivenResult)]) -> Result<String> {
+    let series: Vec<plots::Series> = histories
+        .iter()
+        .map(|(_, design, h)| plots::Series {
+            name: design.clone(),
+            points: first_turn(h, |k| h.fa_abs_n[k]),
+        })
+        .collect();
+    plots::line_chart(
+        "Crank–rod pin force over one revolution (φ = 40πt, gravity on)",
+        "crank angle φ [°] (0 = top dead centre)",
+        "|F_A| [N]",
+        &series,
+        plots::Scale::Linear,
+        plots::Scale::Linear,
+    )
+}
+
+/// `cycle.csv` of one design: per instant the crank angle, the time, the judged max von Mises, the
+/// fixed bore's reaction and the dynamics' F_B (rod frame, N).
+pub fn cycle_csv(c: &DesignCycle) -> Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record([
+        "crank_angle_deg",
+        "time_s",
+        "max_von_mises_away_from_fixed_mpa",
+        "reaction_b_x_n",
+        "reaction_b_y_n",
+        "reaction_b_z_n",
+        "dynamics_f_b_x_n",
+        "dynamics_f_b_y_n",
+    ])?;
+    for h in &c.history {
+        w.write_record(
+            [
+                h.crank_angle_deg,
+                h.time_s,
+                h.max_von_mises_away_from_fixed_mpa,
+                h.reaction_b_n[0],
+                h.reaction_b_n[1],
+                h.reaction_b_n[2],
+                h.dynamics_f_b_n[0],
+                h.dynamics_f_b_n[1],
+            ]
+            .map(|v| format!("{v:e}")),
+        )?;
+    }
+    Ok(w.into_inner()?)
+}
+
+/// `cycle.svg` of one design: the judged max von Mises over one revolution.
+pub fn cycle_plot(design: &str, c: &DesignCycle) -> Result<String> {
+    let series = vec![plots::Series {
+        name: "max von Mises".into(),
+        points: c
+            .history
+            .iter()
+            .map(|h| (h.crank_angle_deg, h.max_von_mises_away_from_fixed_mpa))
+            .collect(),
+    }];
+    plots::line_chart(
+        &format!("{design}: max von Mises over one revolution (inertia relief)"),
+        "crank angle φ [°] (0 = top dead centre)",
+        "max von Mises away from the fixed bore [MPa]",
+        &series,
+        plots::Scale::Linear,
+        plots::Scale::Linear,
+    )
+}
+
+/// `pin_force.csv` of one design: the pin-force history ([`write_history_csv`]).
+pub fn pin_force_csv(design: &str, run: &DrivenResult) -> Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    write_history_csv(&mut w, design, run)?;
+    Ok(w.into_inner()?)
+}
+
+/// The pin-force history as CSV rows (with a `design` column, so several designs share a file).
+pub fn write_history_csv<W: std::io::Write>(
+    w: &mut csv::Writer<W>,
+    design: &str,
+    run: &DrivenResult,
+) -> Result<()> {
+    for k in 0..run.t_s.len() {
+        w.serialize(HistoryRow {
+            design,
+            t_s: run.t_s[k],
+            phi_rad: run.phi_rad[k],
+            fa_x_n: run.fa_x_n[k],
+            fa_y_n: run.fa_y_n[k],
+            fa_abs_n: run.fa_abs_n[k],
+            fb_x_n: run.fb_x_n[k],
+            fb_y_n: run.fb_y_n[k],
+            fb_abs_n: run.fb_abs_n[k],
+            crank_torque_nm: run.crank_torque_nm[k],
+        })?;
+    }
+    Ok(())
+}
+
+#[derive(Serialize)]
+struct HistoryRow<'a> {
+    design: &'a str,
+    t_s: f64,
+    phi_rad: f64,
+    fa_x_n: f64,
+    fa_y_n: f64,
+    fa_abs_n: f64,
+    fb_x_n: f64,
+    fb_y_n: f64,
+    fb_abs_n: f64,
+    crank_torque_nm: f64,
+}

@@ -1,0 +1,293 @@
+//! The field files of one design, written after its stages have computed them: the ParaView files
+//! of stage 3 (`<stem>_fx.vtu`, `_fy.vtu`: displacement, averaged and recovered von Mises, the
+//! stress tensor, the bore sets, the error indicator) and of the cycle (`cycle.vtu`: max von Mises
+//! over the revolution, the fatigue factor, the signed alternating and mean stresses), and the
+//! stress pictures of both (`von_mises_fx.svg`, `_fy.svg`, `von_mises_cycle.svg`). The records
+//! get the paths written.
+
+use super::atomic_write::write_atomic;
+use super::vtu::{VtuField, write_vtu};
+use crate::fem::cycle::{CycleSolution, UnitSolutions};
+use crate::fem::error::{FemError, Result};
+use crate::fem::estimate::ErrorEstimate;
+use crate::fem::picture::{PictureOptions, render_tet10_field};
+use crate::fem::rod::{FemResult, LoadCaseResult, RodSolution};
+use crate::fem::stress::StressField;
+use crate::fem::{BoreSurface, TetMesh};
+use crate::stages::records::DesignCycle;
+use std::path::Path;
+
+/// Writes the ParaView files `<dir>/<stem>_fx.vtu` and `_fy.vtu` of the fields `solution` on
+/// `mesh`, and the pictures of the von Mises field `<dir>/von_mises_fx.svg` and `_fy.svg`, and
+/// records their paths in the figures `result` (the solution's own, as the stage reports them).
+pub fn write_fem_fields(
+    result: &mut FemResult,
+    solution: &RodSolution,
+    mesh: &TetMesh,
+    dir: &Path,
+    stem: &str,
+) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| FemError::io(dir, e))?;
+    for c in 0..2 {
+        let case = if c == 0 {
+            &mut result.fx
+        } else {
+            &mut result.fy
+        };
+        let path = dir.join(format!("{stem}_{}.vtu", case.name));
+        write_case_vtu(
+            &path,
+            mesh,
+            &solution.displacements[c],
+            &solution.stresses[c],
+            &solution.estimates[c],
+            &solution.fixed,
+            &solution.loaded,
+            &solution.away_from_fixed,
+        )?;
+        case.vtu = Some(path);
+        let picture = dir.join(format!("von_mises_{}.svg", case.name));
+        write_case_picture(&picture, mesh, &solution.stresses[c], case)?;
+        case.picture = Some(picture);
+    }
+    Ok(())
+}
+
+/// The picture of one case: the nodally averaged von Mises stress on the surface, the colour
+/// scale up to the judged peak (away from the fixed bore and the singular edges; the singular
+/// peaks above it get the scale's "over" colour) and that peak marked.
+fn write_case_picture(
+    path: &Path,
+    mesh: &TetMesh,
+    field: &StressField,
+    case: &LoadCaseResult,
+) -> Result<()> {
+    let values: Vec<f64> = field
+        .von_mises_averaged()
+        .iter()
+        .map(|v| v * 1e-6)
+        .collect();
+    let peak = case.max_von_mises_away_from_fixed_mpa;
+    let label = if case.name == "fx" { "F_x" } else { "F_y" };
+    let svg = render_tet10_field(
+        mesh,
+        &values,
+        &PictureOptions {
+            title: format!(
+                "von Mises stress [MPa], {label} case: {:.0} N on the crank-pin bore, small-end bore fixed",
+                case.force_n
+            ),
+            unit: "MPa".into(),
+            range: [0.0, if peak > 0.0 { peak } else { 1.0 }],
+            marker_mm: Some(case.max_von_mises_away_from_fixed_at_mm),
+            marker_label: format!(
+                "peak {peak:.1} MPa ± {:.1} %",
+                100.0 * case.estimated_error_rel
+            ),
+            width_px: 960,
+        },
+    )
+    .map_err(|e| FemError::Check(format!("{}: picture: {e:#}", path.display())))?;
+    let tmp = path.with_extension("svg.tmp");
+    std::fs::write(&tmp, svg).map_err(|e| FemError::io(&tmp, e))?;
+    std::fs::rename(&tmp, path).map_err(|e| FemError::io(path, e))?;
+    Ok(())
+}
+
+#[allow(clippy::too_many_arguments)]
+fn write_case_vtu(
+    path: &Path,
+    mesh: &TetMesh,
+    u: &[f64],
+    field: &StressField,
+    estimate: &ErrorEstimate,
+    fixed: &BoreSurface,
+    loaded: &BoreSurface,
+    away: &[bool],
+) -> Result<()> {
+    let u_mm: Vec<f64> = u.iter().map(|v| v * 1e3).collect();
+    let vm_mpa: Vec<f64> = field
+        .von_mises_averaged()
+        .iter()
+        .map(|v| v * 1e-6)
+        .collect();
+    let vm_rec_mpa: Vec<f64> = estimate
+        .recovered_von_mises_pa
+        .iter()
+        .map(|v| v * 1e-6)
+        .collect();
+    let err_mpa: Vec<f64> = estimate
+        .element_von_mises_error_pa
+        .iter()
+        .map(|v| v * 1e-6)
+        .collect();
+    let sig_mpa: Vec<f64> = field
+        .averaged
+        .iter()
+        .flat_map(|s| s.map(|v| v * 1e-6))
+        .collect();
+    let mut set = vec![0.0; mesh.n_nodes()];
+    for &n in &loaded.nodes {
+        set[n] = 1.0;
+    }
+    for &n in &fixed.nodes {
+        set[n] = 2.0;
+    }
+    let near: Vec<f64> = away.iter().map(|a| if *a { 0.0 } else { 1.0 }).collect();
+    let cell_vm: Vec<f64> = field
+        .von_mises_element_max()
+        .iter()
+        .map(|v| v * 1e-6)
+        .collect();
+    write_vtu(
+        path,
+        mesh,
+        &[
+            VtuField {
+                name: "displacement_mm",
+                components: 3,
+                data: &u_mm,
+            },
+            VtuField {
+                name: "von_mises_averaged_MPa",
+                components: 1,
+                data: &vm_mpa,
+            },
+            VtuField {
+                name: "von_mises_recovered_MPa",
+                components: 1,
+                data: &vm_rec_mpa,
+            },
+            VtuField {
+                name: "stress_averaged_MPa",
+                components: 6,
+                data: &sig_mpa,
+            },
+            VtuField {
+                name: "bore_set_1loaded_2fixed",
+                components: 1,
+                data: &set,
+            },
+            VtuField {
+                name: "near_fixed_band",
+                components: 1,
+                data: &near,
+            },
+        ],
+        &[
+            VtuField {
+                name: "von_mises_max_unaveraged_MPa",
+                components: 1,
+                data: &cell_vm,
+            },
+            VtuField {
+                name: "von_mises_error_indicator_MPa",
+                components: 1,
+                data: &err_mpa,
+            },
+        ],
+    )
+}
+
+fn write_cycle_vtu(
+    path: &Path,
+    mesh: &TetMesh,
+    cycle: &CycleSolution,
+    units: &UnitSolutions,
+) -> anyhow::Result<()> {
+    let mpa = |v: &[f64]| v.iter().map(|x| x * 1e-6).collect::<Vec<_>>();
+    // ∞ (an unloaded node) is written as a large finite number: ParaView reads no "inf"
+    let factor: Vec<f64> = cycle
+        .fatigue_safety_factor
+        .iter()
+        .map(|v| v.min(1e6))
+        .collect();
+    let judged: Vec<f64> = units
+        .judged
+        .iter()
+        .map(|j| if *j { 1.0 } else { 0.0 })
+        .collect();
+    write_vtu(
+        path,
+        mesh,
+        &[
+            VtuField {
+                name: "von_mises_max_over_cycle_MPa",
+                components: 1,
+                data: &mpa(&cycle.max_von_mises_pa),
+            },
+            VtuField {
+                name: "fatigue_safety_factor_goodman",
+                components: 1,
+                data: &factor,
+            },
+            VtuField {
+                name: "signed_von_mises_alternating_MPa",
+                components: 1,
+                data: &mpa(&cycle.alternating_pa),
+            },
+            VtuField {
+                name: "signed_von_mises_mean_MPa",
+                components: 1,
+                data: &mpa(&cycle.mean_pa),
+            },
+            VtuField {
+                name: "judged_node",
+                components: 1,
+                data: &judged,
+            },
+        ],
+        &[],
+    )?;
+    Ok(())
+}
+
+fn write_cycle_picture(
+    path: &Path,
+    mesh: &TetMesh,
+    cycle: &CycleSolution,
+    record: &DesignCycle,
+) -> anyhow::Result<()> {
+    let values: Vec<f64> = cycle.max_von_mises_pa.iter().map(|v| v * 1e-6).collect();
+    let peak = record.max_von_mises_over_cycle_mpa;
+    let svg = render_tet10_field(
+        mesh,
+        &values,
+        &PictureOptions {
+            title: format!(
+                "max von Mises over one revolution [MPa] (inertia relief, {:.0} rad/s)",
+                record.omega_rad_s
+            ),
+            unit: "MPa".into(),
+            range: [0.0, if peak > 0.0 { peak } else { 1.0 }],
+            marker_mm: Some(record.location_of_max_mm),
+            marker_label: format!(
+                "max {peak:.1} MPa at φ = {:.0}°",
+                record.crank_angle_of_max_deg
+            ),
+            width_px: 960,
+        },
+    )?;
+    write_atomic(path, svg.as_bytes())?;
+    Ok(())
+}
+
+/// Writes `dir/cycle.vtu` and `dir/von_mises_cycle.svg` of the cycle stage and records their
+/// paths in `record`.
+pub fn write_cycle_fields(
+    record: &mut DesignCycle,
+    mesh: &TetMesh,
+    cycle: &CycleSolution,
+    units: &UnitSolutions,
+    dir: &Path,
+) -> anyhow::Result<()> {
+    use anyhow::Context;
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let vtu = dir.join("cycle.vtu");
+    write_cycle_vtu(&vtu, mesh, cycle, units)?;
+    let picture = dir.join("von_mises_cycle.svg");
+    write_cycle_picture(&picture, mesh, cycle, record)?;
+    record.vtu = Some(vtu);
+    record.picture = Some(picture);
+    Ok(())
+}

@@ -1,0 +1,148 @@
+//! The study's report files: `results.json` (and the uncommitted `timings.json`), the mass
+//! properties and ranking tables, per-design pin-force and cycle CSV files and plots, the
+//! all-design plots, the Pareto front and `index.html`, each written atomically.
+
+use super::atomic_write::write_atomic;
+use super::{design_files, file_safe, index_page, mass_properties, pareto, plots, ranking};
+use crate::study::results::StudyResults;
+use anyhow::Result;
+use std::path::{Path, PathBuf};
+
+/// The keys of the stage-3 record that hold wall times or memory: they vary from run to run.
+const WALL_TIME_KEYS: [&str; 5] = [
+    "seconds",
+    "analysis_seconds",
+    "total_s",
+    "timings",
+    "peak_memory_mb",
+];
+
+/// Removes the wall-time keys from a JSON value, at every depth.
+fn strip_wall_times(v: &mut serde_json::Value) {
+    match v {
+        serde_json::Value::Object(map) => {
+            for k in WALL_TIME_KEYS {
+                map.remove(k);
+            }
+            for x in map.values_mut() {
+                strip_wall_times(x);
+            }
+        }
+        serde_json::Value::Array(a) => a.iter_mut().for_each(strip_wall_times),
+        _ => {}
+    }
+}
+
+/// Writes `results.json`, `mass_properties.md` and `mass_properties.csv` into `out`
+/// (each atomically) and returns their paths.
+pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>> {
+    // results.json holds only what the computation decides (it is committed and must not change
+    // from run to run); the same record with the wall times goes to timings.json (not committed)
+    let full = serde_json::to_value(results)?;
+    write_atomic(
+        &out.join("timings.json"),
+        serde_json::to_string_pretty(&full)?.as_bytes(),
+    )?;
+    let mut stable = full;
+    if let Some(designs) = stable.get_mut("designs").and_then(|d| d.as_array_mut()) {
+        for d in designs {
+            for stage in ["fem", "cycle"] {
+                if let Some(v) = d.get_mut(stage) {
+                    strip_wall_times(v);
+                }
+            }
+        }
+    }
+    let json = out.join("results.json");
+    write_atomic(&json, serde_json::to_string_pretty(&stable)?.as_bytes())?;
+    let md = out.join("mass_properties.md");
+    write_atomic(&md, mass_properties::markdown(results).as_bytes())?;
+    let csv_path = out.join("mass_properties.csv");
+    write_atomic(&csv_path, &mass_properties::csv_table(results)?)?;
+    let ranking = out.join("ranking.md");
+    write_atomic(&ranking, ranking::markdown(results).as_bytes())?;
+    let ranking_csv = out.join("ranking.csv");
+    write_atomic(&ranking_csv, &ranking::csv(results)?)?;
+    let mut written = vec![json, md, csv_path, ranking, ranking_csv];
+    let histories = design_files::histories(results);
+    for (id, design, h) in &histories {
+        let dir = out.join(file_safe(id));
+        let path = dir.join("pin_force.csv");
+        write_atomic(&path, &design_files::pin_force_csv(design, h)?)?;
+        let plot = dir.join("pin_force.svg");
+        write_atomic(
+            &plot,
+            design_files::design_pin_force_plot(design, h)?.as_bytes(),
+        )?;
+        written.extend([path, plot]);
+    }
+    for d in &results.designs {
+        if let Some(c) = &d.cycle {
+            let dir = out.join(file_safe(&d.mass.id));
+            let path = dir.join("cycle.csv");
+            write_atomic(&path, &design_files::cycle_csv(c)?)?;
+            let plot = dir.join("cycle.svg");
+            write_atomic(
+                &plot,
+                design_files::cycle_plot(&d.mass.design, c)?.as_bytes(),
+            )?;
+            written.extend([path, plot]);
+        }
+    }
+    if !histories.is_empty() {
+        let pin = out.join("pin_force.svg");
+        write_atomic(&pin, design_files::pin_force_plot(&histories)?.as_bytes())?;
+        let bars = out.join("peak_force.svg");
+        let peaks: Vec<(String, f64)> = ranking::ranking(results)
+            .iter()
+            .filter_map(|r| Some((r.mass.id.clone(), r.peak_force_n()?)))
+            .collect();
+        write_atomic(
+            &bars,
+            plots::bar_chart(
+                "Peak crank–rod pin force (φ = 40πt, gravity on)",
+                "peak |F_A| [N]",
+                &peaks,
+            )?
+            .as_bytes(),
+        )?;
+        written.extend([pin, bars]);
+    }
+    if !results.designs.is_empty() {
+        let md = out.join("pareto.md");
+        write_atomic(&md, pareto::markdown(results).as_bytes())?;
+        let csv_path = out.join("pareto.csv");
+        write_atomic(&csv_path, &pareto::csv(results)?)?;
+        let svg = out.join("pareto.svg");
+        let points: Vec<plots::LabelledPoint> = pareto::pareto(results)
+            .into_iter()
+            .map(|r| plots::LabelledPoint {
+                label: format!(
+                    " {}{}",
+                    r.id,
+                    r.safety_factor
+                        .map_or(String::new(), |s| format!(" (SF {s:.2})"))
+                ),
+                x: r.mass_kg,
+                y: r.peak_pin_force_n,
+                highlight: r.on_front,
+            })
+            .collect();
+        write_atomic(
+            &svg,
+            plots::scatter_chart(
+                "Pareto front: mass, peak pin force, safety factor",
+                "mass [kg]",
+                "peak crank–rod pin force [N]",
+                &points,
+                "on the Pareto front",
+            )?
+            .as_bytes(),
+        )?;
+        written.extend([md, csv_path, svg]);
+    }
+    let index = out.join("index.html");
+    write_atomic(&index, index_page::index_html(results, out).as_bytes())?;
+    written.push(index);
+    Ok(written)
+}

@@ -1,0 +1,95 @@
+//! The cycle stage for one design: stress over one crank revolution on stage 3's mesh, with
+//! inertia relief, and the Goodman fatigue safety factor (see [`crate::fem::cycle`]).
+//!
+//! Loads and kinematics come from the driven scene's mechanism at the study's crank speed, gravity
+//! on, evaluated with the **mesh's** mass properties (mass, centroid, I_zz from the tet10 mesh with
+//! the design's density), so that the reaction at the fixed bore B equals the piston pin's force
+//! F_B of the dynamics at every instant; the stage reports how far those properties are from the
+//! STL's exact ones.
+
+use super::records::{DesignCycle, DesignMass, StageMesh};
+use crate::config::StudyConfig;
+use crate::fem::QuadratureChoice;
+use crate::fem::cycle::{
+    CycleOptions, CycleSolution, UnitSolutions, combine, rod_inertia_of, unit_solutions,
+};
+use crate::fem::material::Material;
+use crate::mechanism::rod_frame_cycle;
+use anyhow::{Context, Result};
+use std::time::Instant;
+
+/// How the mean and alternating stresses are formed (reported as `method`).
+pub const FATIGUE_METHOD: &str = "signed von Mises (sign of the hydrostatic stress; Bishop & Sherratt, NAFEMS 2000) per node over one revolution: σa = (max − min)/2, σm = (max + min)/2; Goodman n = 1/(σa/Se + σm/Sut), compressive mean not credited (Shigley §6-12)";
+
+/// The cycle stage's record and the fields it was formed from (for the report's `cycle.vtu` and
+/// picture).
+pub struct CycleOutcome {
+    pub record: DesignCycle,
+    pub units: UnitSolutions,
+    pub cycle: CycleSolution,
+}
+
+/// Runs the cycle stage on stage 3's mesh (writes nothing).
+pub fn cycle(mass: &DesignMass, mesh: &StageMesh, config: &StudyConfig) -> Result<CycleOutcome> {
+    let start = Instant::now();
+    let context = || format!("{}: cycle", mass.file);
+    let material = Material::from(&config.fem);
+    let options = CycleOptions {
+        density_kg_m3: mass.density_kg_m3,
+        fixed_band_m: mesh.fixed_band_m,
+        singular_edges_m: mesh.singular_edges_m.clone(),
+        singular_band_m: mesh.singular_band_m,
+        endurance_pa: config.material.endurance_mpa * 1e6,
+        ultimate_pa: config.material.ultimate_mpa * 1e6,
+        quadrature: QuadratureChoice::Auto,
+    };
+    let units =
+        unit_solutions(&mesh.mesh, &material, &mesh.bores, &options).with_context(context)?;
+    let params = super::dynamics::mechanism_for(mass, true);
+    let instants = rod_frame_cycle(
+        &params,
+        &rod_inertia_of(&units.mass),
+        config.driven.omega_rad_s,
+        config.cycle.instants,
+    )
+    .with_context(context)?;
+    let cycle = combine(&units, &instants, &options).with_context(context)?;
+    let analysis_seconds = start.elapsed().as_secs_f64();
+    let nodes = mesh.mesh.nodes();
+    let mm = |n: usize| nodes[n].map(|v| v * 1e3);
+    let k = cycle.max_instant;
+    let f = cycle.fatigue_node;
+    let mut record = DesignCycle {
+        max_von_mises_over_cycle_mpa: cycle.history[k].max_von_mises_away_from_fixed_mpa,
+        crank_angle_of_max_deg: cycle.history[k].crank_angle_deg,
+        location_of_max_mm: mm(cycle.max_node),
+        fatigue_safety_factor: cycle.fatigue_safety_factor[f],
+        fatigue_location_mm: mm(f),
+        fatigue_alternating_mpa: cycle.alternating_pa[f] * 1e-6,
+        fatigue_mean_mpa: cycle.mean_pa[f] * 1e-6,
+        method: FATIGUE_METHOD.into(),
+        endurance_mpa: config.material.endurance_mpa,
+        ultimate_mpa: config.material.ultimate_mpa,
+        instants: instants.len(),
+        omega_rad_s: config.driven.omega_rad_s,
+        mass_properties: "the mesh's (mass, centroid, I_zz of the tet10 mesh at the design's density), for the pin forces and the body forces alike, so that the reaction at B equals the dynamics' F_B".into(),
+        mesh_mass_kg: units.mass.mass_kg,
+        stl_mass_kg: mass.mass_kg,
+        reaction_mismatch_rel: cycle.reaction_mismatch_rel,
+        peak_pin_force_n: instants
+            .iter()
+            .map(|i| i.f_a_on_rod_n[0].hypot(i.f_a_on_rod_n[1]))
+            .fold(0.0, f64::max),
+        history: cycle.history.clone(),
+        vtu: None,
+        picture: None,
+        analysis_seconds,
+        seconds: 0.0,
+    };
+    record.seconds = start.elapsed().as_secs_f64();
+    Ok(CycleOutcome {
+        record,
+        units,
+        cycle,
+    })
+}

@@ -1,0 +1,367 @@
+//! Stage 3 for one design: mesh the rod with gmsh (tet10, `pipeline/mesh_rod.py`, through
+//! [`crate::mesher`]), solve the two load cases F_x and F_y of the design's peak pin force, refine
+//! adaptively until the estimated error of the judged peak is at most the target (or keep one
+//! fixed mesh, or take the user's), judge the stress criterion (SPEC "Stage 3", "Outputs"). One
+//! function per mesh mode; [`fem`] picks by [`MeshMode`]. The stage writes no report file: it
+//! returns the record, the final mesh and the fields ([`crate::report::fields`] writes them).
+//!
+//! **Any units, any pose.** The rod is meshed in its own frame, in millimetres
+//! ([`super::rod_surface`]). Locations in the results are rod-frame millimetres; the VTU files
+//! are in the same frame.
+//!
+//! The criterion is judged on the convergent measure, the maximum nodally averaged von Mises
+//! stress outside a fixed physical band around the fixed bore (the fully fixed bore edge is a
+//! singularity whose peak grows with refinement), optionally plus its estimated error; the raw
+//! peak is reported beside it.
+
+use super::criterion::verdict;
+use super::records::{AdaptiveSummary, DesignFem, LoadedDesign, MeshSummary, StageMesh};
+use super::rod_surface::{RodFrameSurface, rod_frame_surface};
+use crate::config::{FemConfig, StudyConfig};
+use crate::fem::adapt::{AdaptOptions, adaptive_rod};
+use crate::fem::facets::{FacetScale, reentrant_edges};
+use crate::fem::refinement::{RefinementStudy, refinement_study};
+use crate::fem::rod::{RodSolution, solve_rod_fields};
+use crate::fem::{BoreSpec, Material, RodOptions, TetMesh};
+use crate::mesher::{GmshRodMesher, MESHER_SCRIPT, MeshReport, convert_mesh};
+use crate::python_env::{pipeline_script, python};
+use anyhow::{Context, Result};
+use std::path::{Path, PathBuf};
+
+/// The dihedral angle (degrees) of gmsh's first surface classification: edges sharper than this
+/// are features, not facet kinks of a curved surface.
+pub const FEATURE_ANGLE_DEG: f64 = 40.0;
+
+/// How stage 3 meshes: one fixed mesh, adaptive refinement, or the user's mesh.
+#[derive(Debug, Clone, PartialEq)]
+pub enum MeshMode {
+    /// One gmsh mesh of this size, mm.
+    Fixed(f64),
+    /// Adaptive refinement with these settings.
+    Adaptive(AdaptiveMeshing),
+    /// The user's volume mesh (in the design's units and pose).
+    User(PathBuf),
+}
+
+/// The settings of adaptive refinement (`[fem]` of the configuration, `--target-error`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct AdaptiveMeshing {
+    /// Target estimated relative error of each case's judged peak.
+    pub target_error: f64,
+    /// Uniform size of the first mesh, the largest and the smallest size asked for, mm.
+    pub initial_size_mm: f64,
+    pub max_size_mm: f64,
+    pub min_size_mm: f64,
+    pub max_iterations: usize,
+    pub max_dofs: usize,
+}
+
+impl AdaptiveMeshing {
+    /// The configuration's settings, with the target `target_error`.
+    pub fn new(c: &FemConfig, target_error: f64) -> Self {
+        AdaptiveMeshing {
+            target_error,
+            initial_size_mm: c.initial_size_mm,
+            max_size_mm: c.max_size_mm,
+            min_size_mm: c.min_size_mm,
+            max_iterations: c.max_iterations,
+            max_dofs: c.max_dofs,
+        }
+    }
+}
+
+impl MeshMode {
+    /// The configuration's choice: adaptive when `fem.target_error` > 0, else fixed.
+    pub fn from_config(config: &StudyConfig) -> Self {
+        if config.fem.adaptive() {
+            MeshMode::Adaptive(AdaptiveMeshing::new(&config.fem, config.fem.target_error))
+        } else {
+            MeshMode::Fixed(config.fem.mesh_size_mm)
+        }
+    }
+}
+
+/// What stage 3 returns: the record, the mesh it ended on (for the cycle) and the fields of the
+/// final solution (for the report's VTU files and pictures).
+pub struct FemOutcome {
+    pub record: DesignFem,
+    pub mesh: StageMesh,
+    pub solution: RodSolution,
+}
+
+/// Stage 3 of a loaded design under `force_n` in the mode asked for; gmsh's files go under
+/// `work_dir`.
+pub fn fem(
+    design: &LoadedDesign,
+    force_n: f64,
+    config: &StudyConfig,
+    work_dir: &Path,
+    mode: &MeshMode,
+) -> Result<FemOutcome> {
+    match mode {
+        MeshMode::Fixed(size_mm) => fem_fixed(design, force_n, config, work_dir, *size_mm),
+        MeshMode::Adaptive(a) => fem_adaptive(design, force_n, config, work_dir, a),
+        MeshMode::User(file) => fem_user_mesh(design, force_n, config, work_dir, file),
+    }
+}
+
+/// What every mode shares: the rod-frame surface, its bores, the material, the singular edges
+/// and the options of the rod analysis.
+struct Setup {
+    surface: RodFrameSurface,
+    bores: BoreSpec,
+    material: Material,
+    singular_edges: Vec<[[f64; 3]; 2]>,
+    rod: RodOptions,
+    /// `<file>: FEM`, the context of every error.
+    context: String,
+}
+
+const FRAME: &str = "rod frame, mm: origin at the crank pin A, x along A→B, z along the pin axis";
+
+impl Setup {
+    fn new(design: &LoadedDesign, config: &StudyConfig) -> Self {
+        let surface = rod_frame_surface(design);
+        let singular_edges: Vec<[[f64; 3]; 2]> =
+            reentrant_edges(&surface.vertices, &surface.triangles, FEATURE_ANGLE_DEG)
+                .into_iter()
+                .map(|s| s.map(|p| p.map(|v| v * 1e-3)))
+                .collect();
+        let rod = RodOptions {
+            fixed_band_m: Some(config.fem.fixed_band_mm * 1e-3),
+            singular_edges_m: singular_edges.clone(),
+            singular_band_m: Some(config.fem.singular_band_mm * 1e-3),
+            ..RodOptions::default()
+        };
+        Setup {
+            bores: surface.bores(),
+            surface,
+            material: Material::from(&config.fem),
+            singular_edges,
+            rod,
+            context: format!("{}: FEM", design.file.display()),
+        }
+    }
+
+    /// The gmsh adapter on this surface (writes `work_dir/rod_frame.stl`).
+    fn mesher(&self, work_dir: &Path) -> Result<GmshRodMesher> {
+        let python = python().with_context(|| self.context.clone())?;
+        GmshRodMesher::new(
+            &python,
+            &pipeline_script(MESHER_SCRIPT),
+            &self.surface.stl_bytes,
+            &self.surface.digest,
+            work_dir,
+            &self.context[..self.context.len() - ": FEM".len()],
+        )
+        .with_context(|| self.context.clone())
+    }
+
+    /// The record and the outcome of a solution on `mesh`.
+    fn outcome(
+        self,
+        force_n: f64,
+        config: &StudyConfig,
+        summary: MeshSummary,
+        mesh: TetMesh,
+        solution: RodSolution,
+    ) -> FemOutcome {
+        let criterion = verdict(&solution.result, config, self.surface.centre_distance_mm);
+        FemOutcome {
+            record: DesignFem {
+                force_n,
+                mesh: summary,
+                fem: solution.result.clone(),
+                criterion,
+            },
+            mesh: StageMesh {
+                mesh,
+                bores: self.bores,
+                singular_edges_m: self.singular_edges,
+                fixed_band_m: config.fem.fixed_band_mm * 1e-3,
+                singular_band_m: config.fem.singular_band_mm * 1e-3,
+            },
+            solution,
+        }
+    }
+
+    fn surface_triangles(&self) -> [usize; 2] {
+        [self.surface.triangles_export, self.surface.triangles.len()]
+    }
+}
+
+/// Stage 3 on one gmsh mesh of uniform size `size_mm` (the thesis' setting is 5 mm).
+pub fn fem_fixed(
+    design: &LoadedDesign,
+    force_n: f64,
+    config: &StudyConfig,
+    work_dir: &Path,
+    size_mm: f64,
+) -> Result<FemOutcome> {
+    let setup = Setup::new(design, config);
+    let mut mesher = setup.mesher(work_dir)?;
+    let meshed = mesher
+        .fixed(size_mm)
+        .with_context(|| setup.context.clone())?;
+    let solution = solve_rod_fields(
+        &meshed.mesh,
+        &setup.material,
+        &setup.bores,
+        force_n,
+        &setup.rod,
+    )
+    .with_context(|| setup.context.clone())?;
+    let r: &MeshReport = &meshed.report;
+    let summary = MeshSummary {
+        source: "gmsh from the STL (straight-sided tet10)".into(),
+        size_mm: Some(r.size_mm),
+        elements: r.elements,
+        nodes: r.nodes,
+        min_sicn: Some(r.min_sicn),
+        min_scaled_jacobian: Some(r.min_scaled_jacobian),
+        seconds: r.seconds_wall.max(r.seconds_total),
+        frame: FRAME.into(),
+        adaptive: None,
+        surface_triangles: setup.surface_triangles(),
+    };
+    Ok(setup.outcome(force_n, config, summary, meshed.mesh, solution))
+}
+
+/// Stage 3 refined adaptively until the estimated error of each case's judged peak is at most
+/// the target ([`crate::fem::adapt`]), sizes floored at the STL's local facet spacing.
+pub fn fem_adaptive(
+    design: &LoadedDesign,
+    force_n: f64,
+    config: &StudyConfig,
+    work_dir: &Path,
+    settings: &AdaptiveMeshing,
+) -> Result<FemOutcome> {
+    let setup = Setup::new(design, config);
+    let mut mesher = setup.mesher(work_dir)?;
+    let facets = FacetScale::new(
+        &setup.surface.vertices,
+        &setup.surface.triangles,
+        FEATURE_ANGLE_DEG,
+        2.0,
+    );
+    let floor = |p: [f64; 3]| facets.at(p.map(|v| v * 1e3)) * 1e-3;
+    let c = settings;
+    let opts = AdaptOptions {
+        target_error_rel: c.target_error,
+        initial_size_m: c.initial_size_mm * 1e-3,
+        max_size_m: c.max_size_mm * 1e-3,
+        min_size_m: c.min_size_mm * 1e-3,
+        max_iterations: c.max_iterations,
+        max_dofs: c.max_dofs,
+        ..AdaptOptions::default()
+    };
+    let out = adaptive_rod(
+        &mut mesher,
+        &setup.material,
+        &setup.bores,
+        force_n,
+        &setup.rod,
+        &opts,
+        &floor,
+    )
+    .with_context(|| setup.context.clone())?;
+    let r = mesher.last_report.expect("at least one mesh");
+    let iterations = out.solution.result.fx.adaptive.len();
+    let summary = MeshSummary {
+        source: "gmsh from the STL (straight-sided tet10), adaptive".into(),
+        size_mm: None,
+        elements: r.elements,
+        nodes: r.nodes,
+        min_sicn: Some(r.min_sicn),
+        min_scaled_jacobian: Some(r.min_scaled_jacobian),
+        seconds: out.mesh_s,
+        frame: FRAME.into(),
+        adaptive: Some(AdaptiveSummary {
+            target_error_rel: c.target_error,
+            stop: out.stop,
+            iterations,
+            initial_size_mm: c.initial_size_mm,
+            min_size_mm: c.min_size_mm,
+            floor: format!(
+                "the STL's local facet spacing on curved surfaces (kinks below {FEATURE_ANGLE_DEG}°), at least min_size_mm"
+            ),
+            facet_spacing_median_mm: facets.median_spacing(),
+            monotone: out.monotone,
+        }),
+        surface_triangles: setup.surface_triangles(),
+    };
+    Ok(setup.outcome(force_n, config, summary, out.mesh, out.solution))
+}
+
+/// Stage 3 on the user's volume mesh `file` (tet10, in the design's units and pose), moved into
+/// the rod frame.
+pub fn fem_user_mesh(
+    design: &LoadedDesign,
+    force_n: f64,
+    config: &StudyConfig,
+    work_dir: &Path,
+    file: &Path,
+) -> Result<FemOutcome> {
+    let setup = Setup::new(design, config);
+    let start = std::time::Instant::now();
+    let python = python().with_context(|| setup.context.clone())?;
+    let out = work_dir.join("user.rodmesh");
+    std::fs::create_dir_all(work_dir)
+        .with_context(|| format!("{}: cannot create", work_dir.display()))?;
+    let read = convert_mesh(&python, &pipeline_script(MESHER_SCRIPT), file, &out, "mm")
+        .with_context(|| format!("{}: cannot use this volume mesh", file.display()))?;
+    // convert read the file's numbers as mm (×1e-3); the file is in the design's units
+    let f = setup.surface.frame;
+    let s = setup.surface.to_metres * 1e3;
+    let mesh = read
+        .map_nodes(|_, p| {
+            let q = nalgebra::Vector3::new(p[0], p[1], p[2]) * s - f.origin;
+            [q.dot(&f.x), q.dot(&f.y), q.dot(&f.z)]
+        })
+        .with_context(|| format!("{}: the mesh in the rod frame", file.display()))?;
+    let solution = solve_rod_fields(&mesh, &setup.material, &setup.bores, force_n, &setup.rod)
+        .with_context(|| setup.context.clone())?;
+    let summary = MeshSummary {
+        source: file.display().to_string(),
+        size_mm: None,
+        elements: mesh.n_elements(),
+        nodes: mesh.n_nodes(),
+        min_sicn: None,
+        min_scaled_jacobian: None,
+        seconds: start.elapsed().as_secs_f64(),
+        frame: FRAME.into(),
+        adaptive: None,
+        surface_triangles: setup.surface_triangles(),
+    };
+    Ok(setup.outcome(force_n, config, summary, mesh, solution))
+}
+
+/// A refinement study of a loaded design (`rodstudy fem --refine`): one uniform gmsh mesh per size
+/// in `sizes_mm` (each in `work_dir/<size>mm`), both cases at `force_n`, the band around the fixed
+/// bore from the configuration ([`crate::fem::refinement`]).
+pub fn fem_refinement(
+    design: &LoadedDesign,
+    force_n: f64,
+    config: &StudyConfig,
+    work_dir: &Path,
+    sizes_mm: &[f64],
+) -> Result<RefinementStudy> {
+    // meshed in the rod frame, mm, as stage 3 meshes (any units and pose)
+    let setup = Setup::new(design, config);
+    let mesher = setup.mesher(work_dir)?;
+    Ok(refinement_study(
+        sizes_mm,
+        |size| {
+            let t = std::time::Instant::now();
+            let m = mesher.uncached(size, &work_dir.join(format!("{size}mm")))?;
+            Ok((m.mesh, t.elapsed().as_secs_f64()))
+        },
+        &setup.material,
+        &setup.bores,
+        force_n,
+        &RodOptions {
+            fixed_band_m: Some(config.fem.fixed_band_mm * 1e-3),
+            ..RodOptions::default()
+        },
+    )?)
+}

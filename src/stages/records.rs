@@ -1,0 +1,184 @@
+//! The records the stages return, one per stage, as written to JSON (SI units; millimetres and
+//! MPa where a field's name says so), and the loaded design every stage starts from. A stage is a
+//! function from a loaded design (read and validated once) and settings to one of these; it writes
+//! no file ([`crate::report`] does).
+
+use crate::fem::adapt::StopReason;
+use crate::fem::cycle::CycleInstant;
+use crate::fem::{BoreSpec, FemResult, TetMesh};
+use crate::mechanism::{Method, PeakSensitivity};
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+
+/// Stage 1's record and the loaded design (file read, surface validated, mass properties, frame).
+pub use crate::geometry::design::{DesignMass, LoadedDesign};
+
+/// The stage-2 record of one design (SI units), as written to JSON.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DesignDynamics {
+    pub design: String,
+    /// True maximum of |F_A| over the motion [N] (refined between samples).
+    pub peak_pin_force_n: f64,
+    /// Crank angle of the peak, in [0, 360) degrees (0 = top dead centre).
+    pub peak_crank_angle_deg: f64,
+    /// First time of the peak [s].
+    pub peak_time_s: f64,
+    /// Largest |F_A| on the output grid [N].
+    pub grid_peak_pin_force_n: f64,
+    pub gravity: bool,
+    /// `closed_form` or `multibody`.
+    pub method: Method,
+    /// What the method computes (no time integration: the driven mechanism has zero DOF).
+    pub model: String,
+    pub omega_rad_s: f64,
+    pub duration_s: f64,
+    pub steps: usize,
+    /// rω²[m4(1 + r/l) + m3(1 + (r/l)(l1/l))]: the top-dead-centre peak without gravity [N].
+    pub tdc_formula_n: f64,
+    /// ∂F/∂m3, ∂F/∂l1, ∂F/∂I_zz of the peak at constant speed.
+    pub sensitivity: PeakSensitivity,
+}
+
+/// How the mesh was made.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MeshSummary {
+    /// `gmsh from the STL` or the user's mesh file.
+    pub source: String,
+    /// Uniform size of a fixed mesh, mm (`null` for adaptive and user meshes).
+    pub size_mm: Option<f64>,
+    pub elements: usize,
+    pub nodes: usize,
+    /// Smallest signed inverse condition number of gmsh's quality measures (1 = perfect).
+    pub min_sicn: Option<f64>,
+    pub min_scaled_jacobian: Option<f64>,
+    /// Meshing time, s (all meshes of an adaptive sequence).
+    pub seconds: f64,
+    /// The frame of the mesh and of every location reported.
+    #[serde(default)]
+    pub frame: String,
+    /// The adaptive sequence, when the mesh was refined adaptively.
+    #[serde(default)]
+    pub adaptive: Option<AdaptiveSummary>,
+    /// Triangles of the STL export and of the surface given to gmsh after simplification.
+    #[serde(default)]
+    pub surface_triangles: [usize; 2],
+}
+
+/// How an adaptive sequence went.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AdaptiveSummary {
+    /// Target estimated error of the judged peak.
+    pub target_error_rel: f64,
+    /// `converged`, `iteration_cap` or `dof_cap`.
+    pub stop: StopReason,
+    /// Meshes made.
+    pub iterations: usize,
+    /// Uniform size of the first mesh, mm.
+    pub initial_size_mm: f64,
+    /// Smallest size asked for, mm.
+    pub min_size_mm: f64,
+    /// How sizes are floored: the STL's facet spacing on curved surfaces.
+    pub floor: String,
+    /// Median facet spacing of the STL's curved surfaces, mm (the typical floor).
+    pub facet_spacing_median_mm: f64,
+    /// Whether each case's peak sequence changed monotonically (Richardson applies), fx and fy.
+    pub monotone: [bool; 2],
+}
+
+/// The stress criterion applied to one design.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StressVerdict {
+    /// yield / safety factor [MPa].
+    pub allowed_mpa: f64,
+    /// What is judged: the larger of the F_x and F_y convergent measures [MPa], plus its
+    /// estimated error when `with_error`.
+    pub governing_mpa: f64,
+    /// `fx` or `fy`: the case that governs.
+    pub governing_case: String,
+    /// Estimated relative error of the governing case's peak.
+    #[serde(default)]
+    pub governing_error_rel: f64,
+    /// Whether the peak plus its estimated error was judged.
+    #[serde(default)]
+    pub with_error: bool,
+    /// The larger raw peak (element-nodal, unaveraged, at the fixed edge) [MPa], for reference.
+    pub raw_peak_mpa: f64,
+    /// yield / governing stress.
+    pub safety_factor: f64,
+    pub pass: bool,
+    /// Where the linear, small-displacement model is out of its depth (peak above yield,
+    /// displacement above 1 % of the centre distance); empty when it is not.
+    #[serde(default)]
+    pub model_validity: Vec<String>,
+    /// The static verdict alone (`pass` also includes fatigue when it is judged).
+    #[serde(default)]
+    pub static_pass: bool,
+    /// The cycle's Goodman safety factor and the smallest accepted, when fatigue is judged.
+    #[serde(default)]
+    pub fatigue_safety_factor: Option<f64>,
+    #[serde(default)]
+    pub fatigue_required: Option<f64>,
+}
+
+/// The stage-3 record of one design.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct DesignFem {
+    /// Load magnitude of both cases: the design's peak pin force [N].
+    pub force_n: f64,
+    pub mesh: MeshSummary,
+    pub fem: FemResult,
+    pub criterion: StressVerdict,
+}
+
+/// The mesh stage 3 ended on, in the rod frame (m), with what a later stage on the same mesh
+/// needs.
+#[derive(Clone, Debug)]
+pub struct StageMesh {
+    pub mesh: TetMesh,
+    pub bores: BoreSpec,
+    /// Sharp re-entrant edges (m) and the bands left out of judged maxima (m).
+    pub singular_edges_m: Vec<[[f64; 3]; 2]>,
+    pub fixed_band_m: f64,
+    pub singular_band_m: f64,
+}
+
+/// The cycle record of one design (JSON fields named by the issue that asked for them).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct DesignCycle {
+    /// Per instant: crank angle, time, judged max von Mises, the fixed bore's reaction and the
+    /// dynamics' F_B (both on the rod at B, rod frame, N).
+    pub history: Vec<CycleInstant>,
+    pub max_von_mises_over_cycle_mpa: f64,
+    pub crank_angle_of_max_deg: f64,
+    /// Rod frame, mm (A at the origin, x towards B, z the pin axis).
+    pub location_of_max_mm: [f64; 3],
+    /// Smallest Goodman safety factor over the judged nodes.
+    pub fatigue_safety_factor: f64,
+    pub fatigue_location_mm: [f64; 3],
+    /// Alternating and mean signed von Mises at that node, MPa.
+    pub fatigue_alternating_mpa: f64,
+    pub fatigue_mean_mpa: f64,
+    /// How mean and alternating stress were formed.
+    pub method: String,
+    pub endurance_mpa: f64,
+    pub ultimate_mpa: f64,
+    /// Instants over the revolution.
+    pub instants: usize,
+    /// Crank speed, rad/s.
+    pub omega_rad_s: f64,
+    /// Which mass properties the loads use, and the mesh's against the STL's.
+    pub mass_properties: String,
+    pub mesh_mass_kg: f64,
+    pub stl_mass_kg: f64,
+    /// Largest |reaction at B − F_B| over the instants, relative to the peak |F_A|.
+    pub reaction_mismatch_rel: f64,
+    /// Largest |F_A| over the cycle with the mesh's mass properties, N.
+    pub peak_pin_force_n: f64,
+    /// ParaView file (max-over-cycle von Mises, fatigue factor) and the picture.
+    pub vtu: Option<PathBuf>,
+    pub picture: Option<PathBuf>,
+    /// Wall time of the analysis (six unit solves with one factorisation, the combination), s.
+    pub analysis_seconds: f64,
+    /// Wall time of the stage (its files, written by the report, not included), s.
+    pub seconds: f64,
+}

@@ -1,0 +1,83 @@
+//! The rod's surface as stage 3 meshes it: the validated surface of stage 1 (metres, the file's
+//! axes) moved into the rod frame and scaled to millimetres (origin at the crank pin A, x̂ along
+//! A→B, ẑ the pin axis: the mechanism frame of [`crate::geometry::mechanism_frame`]), then
+//! simplified by quadric error metrics ([`crate::geometry::simplify`]) within
+//! [`SIMPLIFY_TOLERANCE_MM`], so that what gmsh reads does not grow with the export's triangle
+//! count. gmsh's sizes and tolerances are then millimetres of a rod in one pose, whatever the CAD
+//! export's units and placement, and the bores sit at (0, 0, 0) and (l, 0, 0).
+
+use super::records::LoadedDesign;
+use crate::fem::BoreSpec;
+use crate::geometry::primitives::{binary_stl, to_soup};
+use crate::geometry::simplify::simplify;
+use crate::geometry::validate::validate;
+
+/// The rod surface in the rod frame, mm, and the binary STL of it that the mesher reads.
+pub struct RodFrameSurface {
+    /// The binary STL of the surface (rod frame, mm).
+    pub stl_bytes: Vec<u8>,
+    /// Vertices (mm, rod frame) and triangles.
+    pub vertices: Vec<[f64; 3]>,
+    pub triangles: Vec<[u32; 3]>,
+    /// Centre distance A→B in the plane of motion, mm.
+    pub centre_distance_mm: f64,
+    /// SHA-256 of the STL bytes (keys the classified-surface cache).
+    pub digest: String,
+    /// Rod frame (origin A, x̂, ŷ, ẑ) in the file's axes, metres, for meshes given by the user.
+    pub frame: crate::geometry::mechanism_frame::MechanismFrame,
+    /// File units → metres.
+    pub to_metres: f64,
+    /// Triangles of the export (the STL written has `triangles.len()`).
+    pub triangles_export: usize,
+    /// Largest distance of a kept vertex from the facets it absorbed, mm.
+    pub simplify_max_error_mm: f64,
+}
+
+/// Tolerance of the simplification of the export before meshing, mm (5 µm: far below any element
+/// size, above the float32 noise of a millimetre export).
+pub const SIMPLIFY_TOLERANCE_MM: f64 = 0.005;
+
+impl RodFrameSurface {
+    /// The pin axes in the rod frame: A at the origin, B at (l, 0, 0), along z.
+    pub fn bores(&self) -> BoreSpec {
+        BoreSpec::from_mm(
+            [0.0, 0.0, 0.0],
+            [self.centre_distance_mm, 0.0, 0.0],
+            [0.0, 0.0, 1.0],
+        )
+    }
+}
+
+/// The validated surface of a loaded design in the rod frame, mm, simplified.
+pub fn rod_frame_surface(d: &LoadedDesign) -> RodFrameSurface {
+    use sha2::Digest;
+    let f = &d.frame;
+    let mut mesh = d.mesh.clone();
+    for v in &mut mesh.vertices {
+        let p = *v - f.origin;
+        *v = nalgebra::Vector3::new(p.dot(&f.x), p.dot(&f.y), p.dot(&f.z)) * 1e3;
+    }
+    // what gmsh reads must not grow with the export's triangle count: flat facets cut into many
+    // triangles merge back (zero error), curved ones stay within SIMPLIFY_TOLERANCE_MM
+    let before = mesh.triangles.len();
+    let (simplified, report) = simplify(&mesh, SIMPLIFY_TOLERANCE_MM);
+    let mesh = match validate(simplified) {
+        Ok(v) if v.warnings.is_empty() => v.mesh,
+        _ => mesh,
+    };
+    let bytes = binary_stl(&to_soup(&mesh));
+    RodFrameSurface {
+        vertices: mesh.vertices.iter().map(|v| [v.x, v.y, v.z]).collect(),
+        triangles: mesh.triangles.clone(),
+        centre_distance_mm: f.centre_distance * 1e3,
+        digest: sha2::Sha256::digest(&bytes)
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect(),
+        stl_bytes: bytes,
+        frame: *f,
+        to_metres: d.settings.units.to_metres(),
+        triangles_export: before,
+        simplify_max_error_mm: report.max_error,
+    }
+}

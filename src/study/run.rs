@@ -1,0 +1,254 @@
+//! The loop over the designs of a folder: every stage on every design, in parallel, one broken
+//! design never stopping the others; cached per design by content hash; a shard of the designs
+//! when the study is split. The stages compute ([`crate::stages`]); their field files (VTU,
+//! pictures) are written by [`crate::report::fields`] as soon as a design's stage 3 is done, so
+//! that its mesh and fields need not be held until the end.
+
+use super::cache::{Cache, design_key};
+use super::results::{DesignResult, FailedDesign, STAGES, StudyResults};
+use super::shard;
+use crate::config::StudyConfig;
+use crate::geometry::design::find_stl_files;
+use crate::mechanism::Method;
+use crate::report::{fields, file_safe};
+use crate::stages;
+use crate::stages::criterion::judge_fatigue;
+use crate::stages::fem::MeshMode;
+use crate::stages::records::{DesignCycle, DesignDynamics, DesignFem, DesignMass};
+use anyhow::{Context, Result, bail};
+use rayon::prelude::*;
+use serde::Serialize;
+use std::path::Path;
+
+/// How a study runs: where, with which settings, how many designs at once.
+pub struct StudyOptions<'a> {
+    pub designs: &'a Path,
+    pub out: &'a Path,
+    pub config: StudyConfig,
+    /// Designs studied at once (rayon threads); 0 = one per core.
+    pub jobs: usize,
+    /// Reuse cached per-design results whose content hash matches.
+    pub use_cache: bool,
+    /// Leave out the FEM stage (a force-only study needs no mesh).
+    pub skip_fem: bool,
+    /// Compute only this share of the designs.
+    pub shard: Option<shard::Shard>,
+}
+
+/// What happened to one design, reported as soon as it is done (for progress output).
+pub struct Progress<'a> {
+    pub file: &'a Path,
+    pub cached: bool,
+    pub outcome: std::result::Result<&'a DesignResult, String>,
+}
+
+/// The figures of one design that the cache keeps (the history is recomputed: it is cheap).
+#[derive(Serialize, serde::Deserialize)]
+struct CachedDesign {
+    mass: DesignMass,
+    dynamics: DesignDynamics,
+    fem: Option<DesignFem>,
+    cycle: Option<DesignCycle>,
+}
+
+/// Runs the stages on every `*.stl` of `options.designs`, designs in parallel, calling
+/// `on_done` as each one finishes.
+pub fn run_study(
+    options: &StudyOptions,
+    on_done: &(dyn Fn(Progress) + Sync),
+) -> Result<StudyResults> {
+    let designs = options.designs;
+    if !designs.is_dir() {
+        bail!("{}: the designs folder does not exist", designs.display());
+    }
+    let all_files = find_stl_files(&[designs.to_path_buf()])?;
+    let (files, shard_record) = match options.shard {
+        None => (all_files, None),
+        Some(sh) => {
+            let mine = shard::share(&all_files, sh);
+            let mut all: Vec<String> = all_files.iter().map(|f| shard::id_of(f)).collect();
+            all.sort();
+            let mut designs: Vec<String> = mine.iter().map(|f| shard::id_of(f)).collect();
+            designs.sort();
+            let record = shard::ShardRecord {
+                shard: sh,
+                all_designs: all,
+                designs,
+            };
+            (mine, Some(record))
+        }
+    };
+    let cache = Cache::new(options.out);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(options.jobs)
+        .build()
+        .context("cannot start the worker threads")?;
+    let outcomes: Vec<std::result::Result<DesignResult, Box<FailedDesign>>> = pool.install(|| {
+        files
+            .into_par_iter()
+            .map(|f| {
+                let (r, cached) = study_one(&f, options, options.use_cache.then_some(&cache));
+                on_done(Progress {
+                    file: &f,
+                    cached,
+                    outcome: r.as_ref().map_err(|e| e.error.clone()),
+                });
+                r
+            })
+            .collect()
+    });
+    // the cycle runs on stage 3's mesh: skipped with it, or on its own by the configuration
+    let skipped = |s: &str| {
+        (options.skip_fem && (s == "fem" || s == "cycle"))
+            || (s == "cycle" && !options.config.cycle.enabled)
+    };
+    let mut results = StudyResults {
+        program_version: env!("CARGO_PKG_VERSION").into(),
+        config: options.config,
+        stages_run: STAGES
+            .iter()
+            .filter(|s| !skipped(s))
+            .map(|s| s.to_string())
+            .collect(),
+        stages_skipped: STAGES
+            .iter()
+            .filter(|s| skipped(s))
+            .map(|s| s.to_string())
+            .collect(),
+        designs: Vec::new(),
+        failed: Vec::new(),
+        shard: shard_record,
+    };
+    for outcome in outcomes {
+        match outcome {
+            Ok(d) => results.designs.push(d),
+            Err(f) => results.failed.push(*f),
+        }
+    }
+    Ok(results)
+}
+
+/// The stages for one design, from the cache when its content hash matches; the flag says
+/// whether the cache answered. A failure keeps what the stages before it computed.
+fn study_one(
+    stl: &Path,
+    options: &StudyOptions,
+    cache: Option<&Cache>,
+) -> (std::result::Result<DesignResult, Box<FailedDesign>>, bool) {
+    let config = &options.config;
+    let id = stl
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let key = cache.and_then(|_| design_key(stl, config).ok()).map(|k| {
+        if options.skip_fem {
+            format!("{k}-without-fem")
+        } else {
+            k
+        }
+    });
+    let scene = config.driven_scene();
+    // the per-design files stage 3 writes beside its figures: a cached entry without them is
+    // recomputed
+    let present = |files: &[&str]| {
+        files
+            .iter()
+            .all(|f| options.out.join(file_safe(&id)).join(f).is_file())
+    };
+    let files_present = |hit: &CachedDesign| {
+        (hit.fem.is_none()
+            || present(&[
+                "von_mises_fx.svg",
+                "von_mises_fy.svg",
+                "fem_fx.vtu",
+                "fem_fy.vtu",
+            ]))
+            && (hit.cycle.is_none() || present(&["von_mises_cycle.svg", "cycle.vtu"]))
+    };
+    if let (Some(cache), Some(key)) = (cache, &key)
+        && let Some(hit) = cache.get::<CachedDesign>(&id, key)
+        && files_present(&hit)
+    {
+        let params = stages::dynamics::mechanism_for(&hit.mass, config.driven.gravity);
+        let rod = stages::dynamics::rod_inertia(&hit.mass);
+        if let Ok(history) =
+            crate::mechanism::driven_scene(&params, &rod, &scene, Method::ClosedForm)
+        {
+            let result = DesignResult {
+                mass: hit.mass,
+                dynamics: hit.dynamics,
+                fem: hit.fem,
+                cycle: hit.cycle,
+                history,
+            };
+            return (Ok(result), true);
+        }
+    }
+    let mut failed = FailedDesign {
+        file: stl.display().to_string(),
+        ..FailedDesign::default()
+    };
+    let computed = (|| {
+        failed.stage = STAGES[0].into();
+        let design = stages::mass::load(stl)?;
+        let mass = stages::mass::mass(&design)?;
+        failed.mass = Some(mass.clone());
+        failed.stage = STAGES[1].into();
+        let (dynamics, history) =
+            stages::dynamics::dynamics(&mass, &scene, config.driven.gravity, Method::ClosedForm)?;
+        failed.dynamics = Some(dynamics.clone());
+        failed.history = Some(history.clone());
+        failed.stage = STAGES[2].into();
+        let (mut fem, mut cycle) = (None, None);
+        if !options.skip_fem {
+            let work = options.out.join(".cache").join("mesh").join(&id);
+            let dir = options.out.join(file_safe(&id));
+            let context = || format!("{}: FEM", stl.display());
+            let mut f = stages::fem::fem(
+                &design,
+                dynamics.peak_pin_force_n,
+                config,
+                &work,
+                &MeshMode::from_config(config),
+            )?;
+            fields::write_fem_fields(&mut f.record.fem, &f.solution, &f.mesh.mesh, &dir, "fem")
+                .with_context(context)?;
+            drop(f.solution);
+            let mut record = f.record;
+            if config.cycle.enabled {
+                failed.stage = STAGES[3].into();
+                let c = stages::cycle::cycle(&mass, &f.mesh, config)?;
+                let mut c_record = c.record;
+                fields::write_cycle_fields(&mut c_record, &f.mesh.mesh, &c.cycle, &c.units, &dir)
+                    .with_context(|| format!("{}: cycle", mass.file))?;
+                judge_fatigue(&mut record.criterion, &c_record, config);
+                cycle = Some(c_record);
+            }
+            fem = Some(record);
+        }
+        anyhow::Ok(DesignResult {
+            mass,
+            dynamics,
+            fem,
+            cycle,
+            history,
+        })
+    })();
+    if let (Ok(d), Some(cache), Some(key)) = (&computed, cache, &key) {
+        let entry = CachedDesign {
+            mass: d.mass.clone(),
+            dynamics: d.dynamics.clone(),
+            fem: d.fem.clone(),
+            cycle: d.cycle.clone(),
+        };
+        // A cache that cannot be written only costs time on the next run.
+        let _ = cache.put(&id, key, &entry);
+    }
+    let outcome = computed.map_err(|e| {
+        Box::new(FailedDesign {
+            error: format!("{e:#}"),
+            ..failed
+        })
+    });
+    (outcome, false)
+}
