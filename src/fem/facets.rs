@@ -11,6 +11,8 @@
 
 use std::collections::HashMap;
 
+use nalgebra::Vector3;
+
 use super::stress::point_triangle_distance;
 
 /// Dihedral angle below which two facets count as coplanar (a subdivided flat face), degrees.
@@ -37,18 +39,9 @@ pub struct FacetScale {
     spacing: Vec<f64>,
 }
 
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn norm(a: [f64; 3]) -> f64 {
-    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+/// A vertex as a nalgebra vector.
+fn v3(p: [f64; 3]) -> Vector3<f64> {
+    Vector3::from(p)
 }
 
 impl FacetScale {
@@ -56,12 +49,12 @@ impl FacetScale {
     /// and above which an edge is a feature (gmsh's classification angle). Units are those of
     /// `vertices`; `cell` is the lookup grid spacing in the same units.
     pub fn new(vertices: &[[f64; 3]], triangles: &[[u32; 3]], feature_deg: f64, cell: f64) -> Self {
-        let corners = |t: &[u32; 3]| t.map(|i| vertices[i as usize]);
+        let corners = |t: &[u32; 3]| t.map(|i| v3(vertices[i as usize]));
         let normal = |t: &[u32; 3]| {
             let [a, b, c] = corners(t);
-            let n = cross(sub(b, a), sub(c, a));
-            let l = norm(n);
-            (n.map(|v| v / l), 0.5 * l)
+            let n = (b - a).cross(&(c - a));
+            let l = n.norm();
+            (n / l, 0.5 * l)
         };
         let edge_faces = edge_faces(triangles);
         let (lo, hi) = (FLAT_DEG.to_radians().cos(), feature_deg.to_radians().cos());
@@ -72,11 +65,11 @@ impl FacetScale {
             }
             let (n0, _) = normal(&triangles[faces[0] as usize]);
             let (n1, _) = normal(&triangles[faces[1] as usize]);
-            let c = n0[0] * n1[0] + n0[1] * n1[1] + n0[2] * n1[2];
+            let c = n0.dot(&n1);
             if !(c < lo && c > hi) {
                 continue;
             }
-            let len = norm(sub(vertices[*a as usize], vertices[*b as usize]));
+            let len = (v3(vertices[*a as usize]) - v3(vertices[*b as usize])).norm();
             for &f in faces {
                 let (_, area) = normal(&triangles[f as usize]);
                 let h = 2.0 * area / len;
@@ -91,7 +84,7 @@ impl FacetScale {
             if !spacing[f].is_finite() {
                 continue;
             }
-            let c = corners(t);
+            let c = t.map(|i| vertices[i as usize]);
             let id = tris.len() as u32;
             tris.push(c);
             sp.push(spacing[f]);
@@ -213,14 +206,12 @@ pub fn reentrant_edges(
         if faces.len() != 2 {
             continue;
         }
-        let t0 = triangles[faces[0] as usize].map(|i| vertices[i as usize]);
+        let t0 = triangles[faces[0] as usize].map(|i| v3(vertices[i as usize]));
         let t1 = triangles[faces[1] as usize];
-        let n0 = cross(sub(t0[1], t0[0]), sub(t0[2], t0[0]));
-        let n0 = n0.map(|v| v / norm(n0));
-        let c1 = t1.map(|i| vertices[i as usize]);
-        let n1 = cross(sub(c1[1], c1[0]), sub(c1[2], c1[0]));
-        let n1 = n1.map(|v| v / norm(n1));
-        let cos = n0[0] * n1[0] + n0[1] * n1[1] + n0[2] * n1[2];
+        let n0 = (t0[1] - t0[0]).cross(&(t0[2] - t0[0])).normalize();
+        let c1 = t1.map(|i| v3(vertices[i as usize]));
+        let n1 = (c1[1] - c1[0]).cross(&(c1[2] - c1[0])).normalize();
+        let cos = n0.dot(&n1);
         if cos > cos_feature {
             continue;
         }
@@ -230,8 +221,7 @@ pub fn reentrant_edges(
             .find(|&&i| i != *a && i != *b)
             .map(|&i| vertices[i as usize])
             .expect("a triangle has a corner off each of its edges");
-        let d = sub(far, t0[0]);
-        if d[0] * n0[0] + d[1] * n0[1] + d[2] * n0[2] > 0.0 {
+        if (v3(far) - t0[0]).dot(&n0) > 0.0 {
             out.push([vertices[*a as usize], vertices[*b as usize]]);
         }
     }
