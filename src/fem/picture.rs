@@ -1554,4 +1554,86 @@ mod tests {
             }
         }
     }
+
+    /// SHA-256 of `s`, lower-case hex.
+    fn sha256_hex(s: &str) -> String {
+        use sha2::Digest;
+        sha2::Sha256::digest(s.as_bytes())
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect()
+    }
+
+    /// Pins the bytes of the pictures: two structured tet10 meshes with deterministic fields drawn
+    /// through [`render_tet10_field`] (marker visible and hidden, values over the range, escaped
+    /// title, two widths). The hashes were taken from the code before `fem/picture.rs` was split
+    /// into `report/picture/`; the split (and any later refactoring) must not change a byte, since
+    /// the study's committed pictures are checked byte for byte.
+    #[test]
+    fn picture_bytes_unchanged() {
+        use crate::fem::mesh::structured::{TwoEyePlate, box_tet10, two_eye_plate};
+        let plate = two_eye_plate(&TwoEyePlate {
+            n_side: 12,
+            n_radial: 6,
+            n_shank: 20,
+            n_z: 6,
+            curved: true,
+            ..Default::default()
+        })
+        .unwrap();
+        let vals: Vec<f64> = plate
+            .nodes()
+            .iter()
+            .map(|p| {
+                let q = p.map(|c| c * 1e3);
+                let r = ((q[0] - 180.0).powi(2) + (q[1] - 12.5).powi(2)).sqrt();
+                60.0 + 0.4 * q[0] + 150.0 * (-(r / 15.0).powi(2)).exp() + 0.5 * q[2]
+            })
+            .collect();
+        let (i_max, v_max) = vals
+            .iter()
+            .enumerate()
+            .fold((0, f64::MIN), |b, (i, &v)| if v > b.1 { (i, v) } else { b });
+        let o = PictureOptions {
+            title: "two-eye plate — synthetic field".into(),
+            range: [0.0, 250.0],
+            marker_mm: Some(plate.nodes()[i_max].map(|c| c * 1e3)),
+            marker_label: format!("peak {v_max:.1} MPa"),
+            ..Default::default()
+        };
+        let plate_svg = render_tet10_field(&plate, &vals, &o).unwrap();
+
+        let block = box_tet10(0.12, 0.03, 0.02, 48, 12, 8).unwrap();
+        let vals: Vec<f64> = block
+            .nodes()
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                // smooth part plus deterministic per-node noise (poorly compressible: the PNGs
+                // exceed the size budget and go through `quantise`)
+                let noise = (i as u64).wrapping_mul(2_654_435_761) % 1000;
+                40.0 * (p[0] * 60.0).sin() + 2e3 * p[1] + 0.05 * noise as f64 + 40.0
+            })
+            .collect();
+        let o = PictureOptions {
+            title: "box <tet10> & \"quoted\"".into(),
+            unit: "N/mm²".into(),
+            range: [12.5, 97.3],
+            // centre of the bottom face: hidden in the plan view
+            marker_mm: Some([60.0, 15.0, 0.0]),
+            marker_label: "bottom".into(),
+            width_px: 700,
+        };
+        let block_svg = render_tet10_field(&block, &vals, &o).unwrap();
+        let got = [sha256_hex(&plate_svg), sha256_hex(&block_svg)];
+        println!("picture hashes: {got:?}");
+        assert!(block_svg.contains("bottom (behind)"));
+        assert_eq!(
+            got,
+            [
+                "0f277b04c0167bac84f935e0aabe164d6ebd57998872a6933b2d5b14cd503c2d",
+                "d1c91c98788a942f7713f162a2e165e988c47e902a5549615383fc401fe915fa",
+            ]
+        );
+    }
 }
