@@ -15,6 +15,7 @@
 //! - [`fem`]: stage 3, linear elasticity with 10-node tetrahedra (gmsh mesh, faer Cholesky),
 //!   von Mises under F_x and F_y;
 //! - [`study`]: running the stages over every design of a folder;
+//! - [`report`]: everything that writes for people to look at (the stress pictures);
 //! - [`python_env`]: the project-local Python environment the `pipeline/` scripts run in;
 //! - [`bench`]: benchmarks, reported as ratios against a reference run;
 //! - [`cli`]: the command-line interface the binary is a thin front over.
@@ -27,4 +28,5 @@ pub mod geometry;
 pub mod integrators;
 pub mod mechanism;
 pub mod python_env;
+pub mod report;
 pub mod study;

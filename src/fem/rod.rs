@@ -476,7 +476,7 @@ fn write_case_picture(
     field: &StressField,
     case: &LoadCaseResult,
 ) -> Result<()> {
-    use super::picture::{PictureOptions, render_tet10_field};
+    use crate::report::picture::{PictureOptions, render_tet10_field};
     let values: Vec<f64> = field
         .von_mises_averaged()
         .iter()

@@ -15,10 +15,10 @@ use crate::fem::cycle::{
     unit_solutions,
 };
 use crate::fem::material::Material;
-use crate::fem::picture::{PictureOptions, render_tet10_field};
 use crate::fem::vtu::{VtuField, write_vtu};
 use crate::geometry::design::DesignMass;
 use crate::mechanism::rod_frame_cycle;
+use crate::report::picture::{PictureOptions, render_tet10_field};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
