@@ -36,7 +36,6 @@ pub mod fatigue;
 pub mod load;
 pub mod material;
 pub mod mesh;
-pub mod picture;
 pub mod quadrature;
 pub mod recovery;
 pub mod refinement;

@@ -8,6 +8,7 @@ pub mod fields;
 pub mod index_page;
 pub mod mass_properties;
 pub mod pareto;
+pub mod picture;
 pub mod plots;
 pub mod ranking;
 pub mod study_report;
