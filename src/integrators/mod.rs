@@ -26,7 +26,7 @@
 //! cubic Hermite dense output of [`rk23`] and [`trbdf2`]); `method.rs` only dispatches
 //! ([`OdeMethod`], [`solve`]) and no method imports it.
 //! The iteration matrices `I − γhJ` of the implicit methods are factored by the crate's one
-//! dense LU, [`crate::mechanism::lu::DenseLu`].
+//! dense LU, [`crate::linalg::DenseLu`].
 //!
 //! Methods (one file each):
 //! - [`initial_acceleration`]: the thesis' "initial acceleration" method (§4.1.1, eq. 4.5–4.13),

@@ -42,8 +42,8 @@ use nalgebra::{Const, DMatrix, DimMin, SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 
 use super::error::{DynamicsError, Result};
-use super::lu::most_dependent_row;
 use super::system::MultibodySystem;
+use crate::linalg::most_dependent_row;
 
 /// Baumgarte's stabilisation parameters (1/s): D c̈ = γ − 2α (D ċ − ν) − β² Φ.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]

@@ -20,7 +20,6 @@
 //! | `revolute.rs` | revolute joint, eq. 2.17–2.19 |
 //! | `translational.rs` | translational joint, eq. 2.28–2.29 |
 //! | `driving.rs` | driving constraint φⱼ − φᵢ = f(t) |
-//! | `lu.rs` | nalgebra's fixed-size LU (partial) and `FullPivLU` (rank-revealing) behind one interface, plus what nalgebra lacks: relative pivot, transposed solve, dependent-row diagnosis |
 //! | `system.rs` | [`MultibodySystem`]: assembly of Φ, D, γ, M, h; Newton–Raphson position analysis, velocity, acceleration, Lagrange multipliers, joint reactions; [`Tracker`] along the motion; `build_with_dof` for systems that keep degrees of freedom |
 //! | `forward.rs` | forward dynamics of such systems: the index-1 form [M −Dᵀ; D 0][c̈; λ] = [h; γ̃] (plain or Baumgarte), constraint violation, projection onto Φ = 0, D ċ = ν |
 //! | `crank_slider.rs` | [`RodInertia`], [`MechanismParams`] (spec defaults, builder, validation), [`CrankSlider`] (validated model, its multibody form), [`PinLoads`] |
@@ -59,7 +58,6 @@ pub mod crank_slider;
 pub mod driving;
 pub mod error;
 pub mod forward;
-pub mod lu;
 pub mod motion;
 pub mod peak;
 pub mod revolute;

@@ -35,7 +35,7 @@
 //! nalgebra's partial-pivoting LU; when its relative pivot falls below
 //! [`RANK_CONFIRM`] (1e-3; healthy crank–slider Jacobians show 0.3–1) the
 //! rank-revealing complete-pivoting LU (nalgebra's `FullPivLU`) decides and is
-//! used instead (see [`lu`](super::lu)). A relative pivot of the
+//! used instead (see [`crate::linalg`]). A relative pivot of the
 //! latter below [`SolverOptions::pivot_threshold`] (1e-8) is reported as
 //! [`DynamicsError::SingularJacobian`] with the time and the joint whose
 //! equation is linearly dependent on the preceding ones (Gram–Schmidt over the
@@ -57,10 +57,10 @@ use super::body::{Body, BodyId, Pose, Twist, cross};
 use super::constraint::{ConstraintEquations, Joint};
 use super::driving::Driving;
 use super::error::{DynamicsError, Result, non_negative, positive};
-use super::lu::{Factorization, most_dependent_row};
 use super::motion::CrankMotion;
 use super::revolute::Revolute;
 use super::translational::Translational;
+use crate::linalg::{Factorization, most_dependent_row};
 
 /// Numerical settings of the kinematic analysis.
 #[derive(Clone, Copy, Debug, PartialEq)]
