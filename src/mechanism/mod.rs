@@ -16,10 +16,11 @@
 //! | `error.rs` | [`DynamicsError`], the typed error (Display names parameter, or time and joint) |
 //! | `body.rs` | body coordinates (x, y, φ), [`BodyId`] (ground implicit), poses, planar helpers |
 //! | `motion.rs` | prescribed motions φ(t), φ̇, φ̈: [`CrankMotion`] |
-//! | `constraint.rs` | the joint interface (Φ, D, ν = −Φ_t, γ) and the [`constraint::Joint`] enum |
+//! | `constraint.rs` | the joint interface (Φ, D, ν = −Φ_t, γ): [`constraint::ConstraintEquations`], [`constraint::JacobianBlocks`] |
 //! | `revolute.rs` | revolute joint, eq. 2.17–2.19 |
 //! | `translational.rs` | translational joint, eq. 2.28–2.29 |
 //! | `driving.rs` | driving constraint φⱼ − φᵢ = f(t) |
+//! | `joint.rs` | the [`joint::Joint`] enum over the three joint types and its dispatch |
 //! | `system.rs` | [`MultibodySystem`]: assembly of Φ, D, γ, M, h; Newton–Raphson position analysis, velocity, acceleration, Lagrange multipliers, joint reactions; [`Tracker`] along the motion; `build_with_dof` for systems that keep degrees of freedom |
 //! | `forward.rs` | forward dynamics of such systems: the index-1 form [M −Dᵀ; D 0][c̈; λ] = [h; γ̃] (plain or Baumgarte), constraint violation, projection onto Φ = 0, D ċ = ν |
 //! | `crank_slider.rs` | [`RodInertia`], [`MechanismParams`] (spec defaults, builder, validation), [`CrankSlider`] (validated model, its multibody form), [`PinLoads`] |
@@ -58,6 +59,7 @@ pub mod crank_slider;
 pub mod driving;
 pub mod error;
 pub mod forward;
+pub mod joint;
 pub mod motion;
 pub mod peak;
 pub mod revolute;

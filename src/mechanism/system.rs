@@ -54,9 +54,10 @@
 use nalgebra::{Const, DMatrix, DimMin, SMatrix, SVector, Vector2};
 
 use super::body::{Body, BodyId, Pose, Twist, cross};
-use super::constraint::{ConstraintEquations, Joint};
+use super::constraint::ConstraintEquations;
 use super::driving::Driving;
 use super::error::{DynamicsError, Result, non_negative, positive};
+use super::joint::Joint;
 use super::motion::CrankMotion;
 use super::revolute::Revolute;
 use super::translational::Translational;
