@@ -3,7 +3,7 @@
 //! scenes, the thesis' Table 5.1, the study helpers, and the hard cases.
 
 use nalgebra::{SVector, Vector2};
-use rodstudy::mechanism::study::{DESIGN_2_L1_M, THESIS_OMEGA_RAD_S};
+use rodstudy::mechanism::table_5_1::{DESIGN_2_L1_M, THESIS_OMEGA_RAD_S};
 use rodstudy::mechanism::{
     BodyId, CrankMotion, CrankSlider, DrivenScene, DynamicsError, L1Fit, MechanismParams, Method,
     MultibodyBuilder, MultibodySystem, RodInertia, TABLE_5_1, bench_driven, compare_results,
