@@ -23,6 +23,7 @@
 //! | `joint.rs` | the [`joint::Joint`] enum over the three joint types and its dispatch |
 //! | `system/` | [`MultibodySystem`] (one file per idea: builder, assembly, analysis, reactions, tracker): assembly of Φ, D, γ, M, h; Newton–Raphson position analysis, velocity, acceleration, Lagrange multipliers, joint reactions; [`Tracker`] along the motion; `build_with_dof` for systems that keep degrees of freedom; its LU is the crate's one, [`crate::linalg::DenseLu`] |
 //! | `forward.rs` | forward dynamics of such systems: the index-1 form [M −Dᵀ; D 0][c̈; λ] = [h; γ̃] (plain or Baumgarte), constraint violation, projection onto Φ = 0, D ċ = ν |
+//! | `linkage.rs` | [`CrankSliderLinkage`]: the crank–slider's bodies and joints O, A, B, slide on the core, written out once (for [`CrankSlider`] and the test rigs) |
 //! | `crank_slider.rs` | [`RodInertia`], [`MechanismParams`] (spec defaults, builder, validation), [`CrankSlider`] (validated model, its multibody form), [`PinLoads`] |
 //! | `closed_form.rs` | closed-form kinematics (eq. 2.1–2.12) and hand-solved Newton–Euler loads: the oracle |
 //! | `rod_cycle.rs` | [`rod_frame_cycle`]: one revolution in the rod frame (a_A, ω₃, α₃, g, pin forces from the rod's Newton–Euler) for the FEM stage |
@@ -62,6 +63,7 @@ pub mod driving;
 pub mod error;
 pub mod forward;
 pub mod joint;
+pub mod linkage;
 pub mod motion;
 pub mod peak;
 pub mod revolute;
@@ -81,6 +83,7 @@ pub use crank_slider::{
 };
 pub use error::{DynamicsError, Result};
 pub use forward::{Baumgarte, ConstraintViolation, ForwardSolution};
+pub use linkage::{CrankSliderLinkage, LinkageJoint};
 pub use motion::{CrankMotion, MotionSample};
 pub use peak::{PeakRefinement, refine_peak, wrap_degrees};
 pub use rod_cycle::{RodFrameInstant, acceleration_of, rod_frame_cycle};

@@ -5,59 +5,26 @@
 
 use super::super::constraint::ConstraintEquations;
 use super::super::error::DynamicsError;
+use super::super::linkage::{CrankSliderLinkage, test_rig};
 use super::super::motion::CrankMotion;
 use super::*;
 use nalgebra::SMatrix;
 
 /// A crank–slider with an offset rod centroid, a crank centroid off O, a
-/// piston force and gravity, built directly on the core.
+/// piston force and gravity: the test rig of [`test_rig`] on the core.
 fn crank_slider(motion: CrankMotion) -> MultibodySystem<9> {
-    let (r, l, l1, off, e) = (0.05, 0.16, 0.06, 0.004, 0.01);
-    let mut b = MultibodyBuilder::new();
-    let crank = b.add_body("crank", 8.0, 0.015);
-    let rod = b.add_body("rod", 3.0, 0.02);
-    let piston = b.add_body("piston", 5.0, 0.0);
-    b.add_revolute(
-        "O",
-        BodyId::Ground,
-        Vector2::zeros(),
-        crank,
-        Vector2::new(-e, 0.0),
-    )
-    .add_revolute(
-        "A",
-        crank,
-        Vector2::new(r - e, 0.0),
-        rod,
-        Vector2::new(-l1, -off),
-    )
-    .add_revolute(
-        "B",
-        rod,
-        Vector2::new(l - l1, -off),
-        piston,
-        Vector2::zeros(),
-    )
-    .add_translational(
-        "slide",
-        BodyId::Ground,
-        Vector2::zeros(),
-        Vector2::new(1.0, 0.0),
-        piston,
-        Vector2::zeros(),
-        0.0,
-    )
-    .add_driving("drive", BodyId::Ground, crank, motion)
-    .add_load(AppliedLoad::Force {
-        body: piston,
-        point: Vector2::zeros(),
-        force: Vector2::new(-150.0, 0.0),
-    })
-    .add_load(AppliedLoad::Torque {
-        body: rod,
-        torque_nm: 0.7,
-    })
-    .gravity(Vector2::new(0.0, -9.81));
+    let mut b = test_rig(0.05, 0.16, 0.01, 0.06, 0.004).builder(["O", "A", "B", "slide"]);
+    b.add_driving("drive", BodyId::Ground, CrankSliderLinkage::CRANK, motion)
+        .add_load(AppliedLoad::Force {
+            body: CrankSliderLinkage::PISTON,
+            point: Vector2::zeros(),
+            force: Vector2::new(-150.0, 0.0),
+        })
+        .add_load(AppliedLoad::Torque {
+            body: CrankSliderLinkage::ROD,
+            torque_nm: 0.7,
+        })
+        .gravity(Vector2::new(0.0, -9.81));
     b.build::<9>().expect("valid model")
 }
 
