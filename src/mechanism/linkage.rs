@@ -7,7 +7,7 @@
 //!
 //! [`CrankSlider`](super::CrankSlider) builds its multibody model from it (with
 //! its own names, loads and driver), and so do the test rigs of the multibody
-//! core (`#[cfg(test)]` [`test_rig`] here, `tests/common` for the end-to-end
+//! core (`test_rig` here, under `#[cfg(test)]`; `tests/common` for the end-to-end
 //! tests).
 //!
 //! Geometry (global frame as in [`crank_slider`](super::crank_slider)): O at
