@@ -4,6 +4,8 @@
 //!
 //! - [`geometry`]: stage 1, reading STL, validating the solid, exact mass properties and the
 //!   mapping into the mechanism frame;
+//! - [`linalg`]: the crate's one small dense LU ([`linalg::DenseLu`]), shared by the mechanism
+//!   core and the implicit integrators;
 //! - [`mechanism`]: stage 2, the planar crank–slider: closed-form Newton–Euler and a planar
 //!   multibody core (thesis §3.2), the driven scene and its peak pin force;
 //! - [`integrators`]: ODE solvers (the thesis' initial-acceleration method, RK45 (optionally
@@ -34,6 +36,7 @@ pub mod fem;
 pub mod free_run;
 pub mod geometry;
 pub mod integrators;
+pub mod linalg;
 pub mod mechanism;
 pub mod mesher;
 pub mod python_env;

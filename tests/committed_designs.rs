@@ -24,7 +24,7 @@ fn committed_designs_have_the_calibrated_properties() {
         });
         let l1_target = row
             .l1_m
-            .unwrap_or(rodstudy::mechanism::study::DESIGN_2_L1_M);
+            .unwrap_or(rodstudy::mechanism::table_5_1::DESIGN_2_L1_M);
         let mass_err = (d.mass_kg - row.mass_kg) / row.mass_kg;
         let ixx_err = (d.i_xx_kgm2 - row.thesis_inertia_kgm2) / row.thesis_inertia_kgm2;
         // measured: mass and I_xx within 1.4e-6 of Table 5.1, l1 within 1e-6 m (the generator's

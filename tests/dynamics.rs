@@ -2,8 +2,11 @@
 //! multibody core against the closed-form Newton–Euler oracle over full
 //! scenes, the thesis' Table 5.1, the study helpers, and the hard cases.
 
+mod common;
+
+use common::{guess, raw_crank_slider};
 use nalgebra::{SVector, Vector2};
-use rodstudy::mechanism::study::{DESIGN_2_L1_M, THESIS_OMEGA_RAD_S};
+use rodstudy::mechanism::table_5_1::{DESIGN_2_L1_M, THESIS_OMEGA_RAD_S};
 use rodstudy::mechanism::{
     BodyId, CrankMotion, CrankSlider, DrivenScene, DynamicsError, L1Fit, MechanismParams, Method,
     MultibodyBuilder, MultibodySystem, RodInertia, TABLE_5_1, bench_driven, compare_results,
@@ -548,80 +551,6 @@ fn invalid_inputs_are_refused_with_typed_errors() {
     assert!(tracker.solve_at(0.0).is_ok());
     let e = tracker.solve_at(0.02).unwrap_err();
     assert!(matches!(e, DynamicsError::NonFinite { .. }), "{e:?}");
-}
-
-/// A crank–slider built directly on the core (so that l <= r is possible):
-/// crank and rod centroids at mid-length, optional duplicate pin at O
-/// instead of the slide, optional slide line y = slide_y.
-fn raw_crank_slider(
-    r: f64,
-    l: f64,
-    motion: CrankMotion,
-    duplicate_pin: bool,
-    slide_y: f64,
-) -> MultibodySystem<9> {
-    let mut b = MultibodyBuilder::new();
-    let crank = b.add_body("crank", 8.0, 0.015);
-    let rod = b.add_body("rod", 3.0, 0.02);
-    let piston = b.add_body("piston", 5.0, 0.0);
-    b.add_revolute(
-        "O",
-        BodyId::Ground,
-        Vector2::zeros(),
-        crank,
-        Vector2::new(-r / 2.0, 0.0),
-    );
-    if duplicate_pin {
-        b.add_revolute(
-            "O duplicate",
-            BodyId::Ground,
-            Vector2::zeros(),
-            crank,
-            Vector2::new(-r / 2.0, 0.0),
-        );
-    }
-    b.add_revolute(
-        "A",
-        crank,
-        Vector2::new(r / 2.0, 0.0),
-        rod,
-        Vector2::new(-l / 2.0, 0.0),
-    )
-    .add_revolute(
-        "B",
-        rod,
-        Vector2::new(l / 2.0, 0.0),
-        piston,
-        Vector2::zeros(),
-    );
-    if !duplicate_pin {
-        b.add_translational(
-            "slide",
-            BodyId::Ground,
-            Vector2::new(0.0, slide_y),
-            Vector2::new(1.0, 0.0),
-            piston,
-            Vector2::zeros(),
-            0.0,
-        );
-    }
-    b.add_driving("crank drive", BodyId::Ground, crank, motion)
-        .gravity(Vector2::new(0.0, -9.81));
-    b.build::<9>().expect("nine equations for nine coordinates")
-}
-
-fn guess(r: f64, l: f64) -> SVector<f64, 9> {
-    SVector::<f64, 9>::from_column_slice(&[
-        r / 2.0,
-        0.0,
-        0.0,
-        r + l / 2.0,
-        0.0,
-        0.0,
-        r + l,
-        0.0,
-        0.0,
-    ])
 }
 
 #[test]

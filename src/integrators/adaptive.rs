@@ -20,7 +20,7 @@
 use super::control::{Controller, check_underflow, clamp_to_end, initial_step, max_step};
 use super::eval::Evaluator;
 use super::grid::Recorder;
-use super::method::{check_input, invalid};
+use super::input::{check_input, invalid};
 use super::norm::Weights;
 use super::{
     FailureKind, OdeSystem, OutputGrid, Solution, SolverError, SolverOptions, StepProjection,

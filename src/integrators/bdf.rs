@@ -22,7 +22,7 @@
 use super::control::{check_underflow, initial_step, max_step, min_step};
 use super::eval::Evaluator;
 use super::grid::Recorder;
-use super::method::{check_input, invalid};
+use super::input::{check_input, invalid};
 use super::newton::{IterationMatrix, Newton, iteration_matrix};
 use super::norm::{Weights, rms_norm};
 use super::{OdeSystem, OutputGrid, Solution, SolverError, SolverOptions};

@@ -14,7 +14,7 @@
 
 use super::eval::Evaluator;
 use super::grid::Recorder;
-use super::method::{check_input, invalid};
+use super::input::{check_input, invalid};
 use super::{FailureKind, OdeSystem, OutputGrid, Solution, SolverError, SolverOptions};
 use nalgebra::DVector;
 

@@ -21,8 +21,12 @@
 //! grid, caps, the optional post-step projection); each method's file holds only its tableau,
 //! stages, error estimate, controller constants and continuous extension. [`bdf`] keeps its
 //! own loop (variable order; its backward differences are rescaled at every step change).
+//! Below the methods, and imported by them: `input.rs` (input checks and the
+//! [`FailureKind::InvalidInput`] error), `control.rs` (step-size selection), `hermite.rs` (the
+//! cubic Hermite dense output of [`rk23`] and [`trbdf2`]); `method.rs` only dispatches
+//! ([`OdeMethod`], [`solve`]) and no method imports it.
 //! The iteration matrices `I − γhJ` of the implicit methods are factored by the crate's one
-//! dense LU, [`crate::mechanism::lu::DenseLu`].
+//! dense LU, [`crate::linalg::DenseLu`].
 //!
 //! Methods (one file each):
 //! - [`initial_acceleration`]: the thesis' "initial acceleration" method (§4.1.1, eq. 4.5–4.13),
@@ -53,6 +57,8 @@ mod control;
 mod error;
 mod eval;
 mod grid;
+mod hermite;
+mod input;
 mod newton;
 mod norm;
 mod options;

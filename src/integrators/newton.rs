@@ -5,7 +5,7 @@
 use super::eval::Evaluator;
 use super::norm::rms_norm;
 use super::{OdeSystem, SolverError};
-use crate::mechanism::lu::DenseLu;
+use crate::linalg::DenseLu;
 use nalgebra::{DMatrix, DVector, Dyn};
 
 /// LU factors (partial pivoting) of an iteration matrix `W = I − c J`, by the crate's one

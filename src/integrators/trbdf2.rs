@@ -24,9 +24,9 @@
 use super::adaptive::{AdaptiveStepper, Attempt, Step, integrate};
 use super::control::Controller;
 use super::eval::Evaluator;
+use super::hermite::hermite;
 use super::newton::{IterationMatrix, Newton, iteration_matrix};
 use super::norm::{Weights, rms_norm};
-use super::rk23::hermite;
 use super::{OdeSystem, OutputGrid, Solution, SolverError, SolverOptions};
 use nalgebra::{DMatrix, DVector};
 use std::f64::consts::SQRT_2;

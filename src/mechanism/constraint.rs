@@ -1,4 +1,4 @@
-//! The common interface of kinematic constraints (joints) and their dispatch.
+//! The common interface of kinematic constraints (joints).
 //!
 //! A joint k between bodies i and j contributes `equations()` rows to
 //!
@@ -14,14 +14,13 @@
 //! reaction D_{k,i}ᵀ λ_k on body i and D_{k,j}ᵀ λ_k on body j (thesis eq. 3.27,
 //! M c̈ = h + Dᵀλ).
 //!
-//! Each joint type lives in its own file and states its equations there:
-//! [`Revolute`], [`Translational`],
-//! [`Driving`].
+//! Each joint type lives in its own file, implements [`ConstraintEquations`]
+//! there and states its equations: [`Revolute`](super::revolute::Revolute),
+//! [`Translational`](super::translational::Translational),
+//! [`Driving`](super::driving::Driving); the enum that dispatches over them is
+//! [`Joint`](super::joint::Joint). This file imports none of them.
 
 use super::body::{BodyId, Pose, Twist};
-use super::driving::Driving;
-use super::revolute::Revolute;
-use super::translational::Translational;
 
 /// Jacobian rows of one joint, split into the 3 columns (x, y, φ) of each of
 /// its two bodies. Only the first `equations()` rows are meaningful.
@@ -50,69 +49,6 @@ pub trait ConstraintEquations {
     fn nu(&self, t: f64) -> [f64; 2];
     /// γ rows.
     fn gamma(&self, pi: &Pose, pj: &Pose, vi: &Twist, vj: &Twist, t: f64) -> [f64; 2];
-}
-
-/// Any joint of the multibody core.
-#[derive(Clone, Debug)]
-pub enum Joint {
-    /// Revolute (pin) joint, 2 equations.
-    Revolute(Revolute),
-    /// Translational (prismatic) joint, 2 equations.
-    Translational(Translational),
-    /// Driving constraint on an angle, 1 equation.
-    Driving(Driving),
-}
-
-impl Joint {
-    /// Short name of the joint type, for messages.
-    pub fn kind(&self) -> &'static str {
-        match self {
-            Joint::Revolute(_) => "revolute",
-            Joint::Translational(_) => "translational",
-            Joint::Driving(_) => "driving",
-        }
-    }
-}
-
-// Static dispatch (no trait objects on the hot path).
-macro_rules! dispatch {
-    ($self:ident, $j:ident => $e:expr) => {
-        match $self {
-            Joint::Revolute($j) => $e,
-            Joint::Translational($j) => $e,
-            Joint::Driving($j) => $e,
-        }
-    };
-}
-
-impl ConstraintEquations for Joint {
-    #[inline]
-    fn equations(&self) -> usize {
-        dispatch!(self, j => j.equations())
-    }
-    #[inline]
-    fn bodies(&self) -> (BodyId, BodyId) {
-        dispatch!(self, j => j.bodies())
-    }
-    fn is_angle_row(&self, k: usize) -> bool {
-        dispatch!(self, j => j.is_angle_row(k))
-    }
-    #[inline]
-    fn phi(&self, pi: &Pose, pj: &Pose, t: f64) -> [f64; 2] {
-        dispatch!(self, j => j.phi(pi, pj, t))
-    }
-    #[inline]
-    fn jacobian(&self, pi: &Pose, pj: &Pose, t: f64) -> JacobianBlocks {
-        dispatch!(self, j => j.jacobian(pi, pj, t))
-    }
-    #[inline]
-    fn nu(&self, t: f64) -> [f64; 2] {
-        dispatch!(self, j => j.nu(t))
-    }
-    #[inline]
-    fn gamma(&self, pi: &Pose, pj: &Pose, vi: &Twist, vj: &Twist, t: f64) -> [f64; 2] {
-        dispatch!(self, j => j.gamma(pi, pj, vi, vj, t))
-    }
 }
 
 /// Test helpers shared by the joint files: finite-difference checks of D

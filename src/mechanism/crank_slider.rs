@@ -28,6 +28,7 @@ use serde::{Deserialize, Serialize};
 
 use super::body::BodyId;
 use super::error::{DynamicsError, Result, finite, non_negative, positive};
+use super::linkage::CrankSliderLinkage;
 use super::motion::CrankMotion;
 use super::system::{
     AppliedLoad, KinematicSolution, MultibodyBuilder, MultibodySystem, SolverOptions,
@@ -339,54 +340,30 @@ impl CrankSlider {
         b.build_with_dof::<9>()
     }
 
-    /// Bodies, joints O, A, B, slide, gravity and the piston force.
+    /// Bodies, joints O, A, B, slide ([`CrankSliderLinkage`]), gravity and the
+    /// piston force.
     fn joints_and_loads(&self, options: SolverOptions) -> MultibodyBuilder {
         let p = &self.params;
-        let (r, l, e) = (
-            p.crank_radius_m,
-            p.centre_distance_m,
-            p.crank_eccentricity_m,
-        );
-        let (l1, off) = (self.rod.l1_m, self.rod.offset_m);
-        let mut b = MultibodyBuilder::new();
-        let crank = b.add_body("crank", p.crank_mass_kg, self.crank_inertia_centroid_kgm2());
-        let rod = b.add_body("rod", self.rod.mass_kg, self.rod.i_zz_kgm2);
-        let piston = b.add_body("piston", p.piston_mass_kg, 0.0);
-        b.add_revolute(
+        let linkage = CrankSliderLinkage {
+            crank_radius_m: p.crank_radius_m,
+            centre_distance_m: p.centre_distance_m,
+            crank_centroid_m: p.crank_eccentricity_m,
+            rod_l1_m: self.rod.l1_m,
+            rod_offset_m: self.rod.offset_m,
+            slide_y_m: 0.0,
+            masses_kg: [p.crank_mass_kg, self.rod.mass_kg, p.piston_mass_kg],
+            inertias_kgm2: [self.crank_inertia_centroid_kgm2(), self.rod.i_zz_kgm2, 0.0],
+        };
+        let mut b = linkage.builder([
             "O (ground-crank)",
-            BodyId::Ground,
-            Vector2::zeros(),
-            crank,
-            Vector2::new(-e, 0.0),
-        )
-        .add_revolute(
             "A (crank-rod)",
-            crank,
-            Vector2::new(r - e, 0.0),
-            rod,
-            Vector2::new(-l1, -off),
-        )
-        .add_revolute(
             "B (rod-piston)",
-            rod,
-            Vector2::new(l - l1, -off),
-            piston,
-            Vector2::zeros(),
-        )
-        .add_translational(
             "slide (ground-piston)",
-            BodyId::Ground,
-            Vector2::zeros(),
-            Vector2::new(1.0, 0.0),
-            piston,
-            Vector2::zeros(),
-            0.0,
-        )
-        .gravity(p.gravity_vector())
-        .options(options);
+        ]);
+        b.gravity(p.gravity_vector()).options(options);
         if p.piston_force_n != 0.0 {
             b.add_load(AppliedLoad::Force {
-                body: piston,
+                body: CrankSliderLinkage::PISTON,
                 point: Vector2::zeros(),
                 force: Vector2::new(p.piston_force_n, 0.0),
             });

@@ -42,8 +42,8 @@ use nalgebra::{Const, DMatrix, DimMin, SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 
 use super::error::{DynamicsError, Result};
-use super::lu::most_dependent_row;
 use super::system::MultibodySystem;
+use crate::linalg::most_dependent_row;
 
 /// Baumgarte's stabilisation parameters (1/s): D c̈ = γ − 2α (D ċ − ν) − β² Φ.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -304,50 +304,17 @@ where
 
 #[cfg(test)]
 mod tests {
-    use super::super::body::BodyId;
-    use super::super::system::MultibodyBuilder;
+    use super::super::linkage::{CrankSliderLinkage, test_rig};
+    use super::super::system::AppliedLoad;
     use super::*;
     use nalgebra::Vector2;
 
-    /// A free crank–slider (no driver) with offset centroids, a torque and gravity.
+    /// A free crank–slider (no driver) with offset centroids, a torque and gravity
+    /// (the test rig of [`test_rig`]).
     fn free_crank_slider() -> MultibodySystem<9> {
-        let (r, l, l1, e) = (0.05, 0.16, 0.06, 0.01);
-        let mut b = MultibodyBuilder::new();
-        let crank = b.add_body("crank", 8.0, 0.015);
-        let rod = b.add_body("rod", 3.0, 0.02);
-        let piston = b.add_body("piston", 5.0, 0.0);
-        b.add_revolute(
-            "O",
-            BodyId::Ground,
-            Vector2::zeros(),
-            crank,
-            Vector2::new(-e, 0.0),
-        )
-        .add_revolute(
-            "A",
-            crank,
-            Vector2::new(r - e, 0.0),
-            rod,
-            Vector2::new(-l1, 0.0),
-        )
-        .add_revolute(
-            "B",
-            rod,
-            Vector2::new(l - l1, 0.0),
-            piston,
-            Vector2::zeros(),
-        )
-        .add_translational(
-            "slide",
-            BodyId::Ground,
-            Vector2::zeros(),
-            Vector2::new(1.0, 0.0),
-            piston,
-            Vector2::zeros(),
-            0.0,
-        )
-        .add_load(super::super::system::AppliedLoad::Torque {
-            body: crank,
+        let mut b = test_rig(0.05, 0.16, 0.01, 0.06, 0.0).builder(["O", "A", "B", "slide"]);
+        b.add_load(AppliedLoad::Torque {
+            body: CrankSliderLinkage::CRANK,
             torque_nm: 2.0,
         })
         .gravity(Vector2::new(0.0, -9.81));
@@ -475,40 +442,7 @@ mod tests {
     fn singular_configuration_is_named() {
         // l = r: at φ = 90° the rod stands vertical over B = O (toggle)
         let (r, l1) = (0.05, 0.02);
-        let mut b = MultibodyBuilder::new();
-        let crank = b.add_body("crank", 8.0, 0.015);
-        let rod = b.add_body("rod", 3.0, 0.02);
-        let piston = b.add_body("piston", 5.0, 0.0);
-        b.add_revolute(
-            "O",
-            BodyId::Ground,
-            Vector2::zeros(),
-            crank,
-            Vector2::zeros(),
-        )
-        .add_revolute(
-            "A",
-            crank,
-            Vector2::new(r, 0.0),
-            rod,
-            Vector2::new(-l1, 0.0),
-        )
-        .add_revolute(
-            "B",
-            rod,
-            Vector2::new(r - l1, 0.0),
-            piston,
-            Vector2::zeros(),
-        )
-        .add_translational(
-            "slide",
-            BodyId::Ground,
-            Vector2::zeros(),
-            Vector2::new(1.0, 0.0),
-            piston,
-            Vector2::zeros(),
-            0.0,
-        );
+        let b = test_rig(r, r, 0.0, l1, 0.0).builder(["O", "A", "B", "slide"]);
         let sys = b.build_with_dof::<9>().unwrap();
         let half_pi = std::f64::consts::FRAC_PI_2;
         let q = SVector::<f64, 9>::from_column_slice(&[

@@ -16,19 +16,22 @@
 //! | `error.rs` | [`DynamicsError`], the typed error (Display names parameter, or time and joint) |
 //! | `body.rs` | body coordinates (x, y, φ), [`BodyId`] (ground implicit), poses, planar helpers |
 //! | `motion.rs` | prescribed motions φ(t), φ̇, φ̈: [`CrankMotion`] |
-//! | `constraint.rs` | the joint interface (Φ, D, ν = −Φ_t, γ) and the [`constraint::Joint`] enum |
+//! | `constraint.rs` | the joint interface (Φ, D, ν = −Φ_t, γ): [`constraint::ConstraintEquations`], [`constraint::JacobianBlocks`] |
 //! | `revolute.rs` | revolute joint, eq. 2.17–2.19 |
 //! | `translational.rs` | translational joint, eq. 2.28–2.29 |
 //! | `driving.rs` | driving constraint φⱼ − φᵢ = f(t) |
-//! | `lu.rs` | nalgebra's fixed-size LU (partial) and `FullPivLU` (rank-revealing) behind one interface, plus what nalgebra lacks: relative pivot, transposed solve, dependent-row diagnosis |
-//! | `system.rs` | [`MultibodySystem`]: assembly of Φ, D, γ, M, h; Newton–Raphson position analysis, velocity, acceleration, Lagrange multipliers, joint reactions; [`Tracker`] along the motion; `build_with_dof` for systems that keep degrees of freedom |
+//! | `joint.rs` | the [`joint::Joint`] enum over the three joint types and its dispatch |
+//! | `system/` | [`MultibodySystem`] (one file per idea: builder, assembly, analysis, reactions, tracker): assembly of Φ, D, γ, M, h; Newton–Raphson position analysis, velocity, acceleration, Lagrange multipliers, joint reactions; [`Tracker`] along the motion; `build_with_dof` for systems that keep degrees of freedom; its LU is the crate's one, [`crate::linalg::DenseLu`] |
 //! | `forward.rs` | forward dynamics of such systems: the index-1 form [M −Dᵀ; D 0][c̈; λ] = [h; γ̃] (plain or Baumgarte), constraint violation, projection onto Φ = 0, D ċ = ν |
+//! | `linkage.rs` | [`CrankSliderLinkage`]: the crank–slider's bodies and joints O, A, B, slide on the core, written out once (for [`CrankSlider`] and the test rigs) |
 //! | `crank_slider.rs` | [`RodInertia`], [`MechanismParams`] (spec defaults, builder, validation), [`CrankSlider`] (validated model, its multibody form), [`PinLoads`] |
 //! | `closed_form.rs` | closed-form kinematics (eq. 2.1–2.12) and hand-solved Newton–Euler loads: the oracle |
 //! | `rod_cycle.rs` | [`rod_frame_cycle`]: one revolution in the rod frame (a_A, ω₃, α₃, g, pin forces from the rod's Newton–Euler) for the FEM stage |
 //! | `peak.rs` | the true maximum of \|F_A\| (scan + golden section on the closed form) |
 //! | `scene.rs` | scene `driven`: [`DrivenScene`], [`Method`], [`driven_scene`], [`DrivenResult`], [`compare_results`] |
-//! | `study.rs` | Table 5.1, the TDC formula, the l₁ that reproduces a peak, peak sensitivities |
+//! | `tdc_peak.rs` | the peak pin force at constant speed: the TDC formula, the refined peak, the l₁ that reproduces a peak ([`L1Fit`]) |
+//! | `table_5_1.rs` | the thesis' Table 5.1 and its reproduction ([`table_5_1_check`]) |
+//! | `sensitivity.rs` | sensitivity of the peak to m₃, l₁, I_zz ([`peak_sensitivity`]) |
 //! | `bench.rs` | [`bench_driven`]: timing of both methods |
 //!
 //! # Conventions
@@ -59,14 +62,17 @@ pub mod crank_slider;
 pub mod driving;
 pub mod error;
 pub mod forward;
-pub mod lu;
+pub mod joint;
+pub mod linkage;
 pub mod motion;
 pub mod peak;
 pub mod revolute;
 pub mod rod_cycle;
 pub mod scene;
-pub mod study;
+pub mod sensitivity;
 pub mod system;
+pub mod table_5_1;
+pub mod tdc_peak;
 pub mod translational;
 
 pub use bench::{DynamicsBench, bench_driven};
@@ -77,15 +83,17 @@ pub use crank_slider::{
 };
 pub use error::{DynamicsError, Result};
 pub use forward::{Baumgarte, ConstraintViolation, ForwardSolution};
+pub use linkage::{CrankSliderLinkage, LinkageJoint};
 pub use motion::{CrankMotion, MotionSample};
 pub use peak::{PeakRefinement, refine_peak, wrap_degrees};
 pub use rod_cycle::{RodFrameInstant, acceleration_of, rod_frame_cycle};
 pub use scene::{Agreement, DrivenResult, DrivenScene, Method, compare_results, driven_scene};
-pub use study::{
-    L1Fit, PeakSensitivity, TABLE_5_1, Table51Check, Table51Row, l1_for_peak_force, peak_pin_force,
-    peak_sensitivity, table_5_1_check, tdc_peak_formula,
-};
+pub use sensitivity::{PeakSensitivity, peak_sensitivity};
 pub use system::{
     AppliedLoad, GeneralizedForce, JointReaction, KinematicSolution, MultibodyBuilder,
     MultibodySystem, SolverOptions, Tracker,
 };
+pub use table_5_1::{
+    DESIGN_2_L1_M, TABLE_5_1, THESIS_OMEGA_RAD_S, Table51Check, Table51Row, table_5_1_check,
+};
+pub use tdc_peak::{L1Fit, l1_for_peak_force, peak_pin_force, tdc_peak_formula};

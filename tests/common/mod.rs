@@ -1,5 +1,12 @@
-//! Helpers shared by the end-to-end tests.
+//! Helpers shared by the end-to-end tests: copying a design, and the one
+//! crank–slider rig built directly on the multibody core.
+// each test binary uses only some of them
+#![allow(dead_code)]
 
+use nalgebra::{SVector, Vector2};
+use rodstudy::mechanism::{
+    BodyId, CrankMotion, CrankSliderLinkage, LinkageJoint, MultibodyBuilder, MultibodySystem,
+};
 use std::path::Path;
 
 /// Copies design `stem` (its STL and sidecar) from folder `from` into folder `to`.
@@ -11,4 +18,61 @@ pub fn copy_design(from: &Path, to: &Path, stem: &str) {
         )
         .unwrap();
     }
+}
+
+/// A crank–slider built directly on the core ([`CrankSliderLinkage`], so that
+/// l <= r is possible): crank 8 kg, rod 3 kg, piston 5 kg, crank and rod
+/// centroids at mid-length, optional duplicate pin at O instead of the slide,
+/// optional slide line y = slide_y, driven by `motion`, with gravity.
+pub fn raw_crank_slider(
+    r: f64,
+    l: f64,
+    motion: CrankMotion,
+    duplicate_pin: bool,
+    slide_y: f64,
+) -> MultibodySystem<9> {
+    let linkage = CrankSliderLinkage {
+        crank_radius_m: r,
+        centre_distance_m: l,
+        crank_centroid_m: r / 2.0,
+        rod_l1_m: l / 2.0,
+        rod_offset_m: 0.0,
+        slide_y_m: slide_y,
+        masses_kg: [8.0, 3.0, 5.0],
+        inertias_kgm2: [0.015, 0.02, 0.0],
+    };
+    let mut b = MultibodyBuilder::new();
+    linkage.add_bodies(&mut b);
+    linkage.add_joint(&mut b, LinkageJoint::O, "O");
+    if duplicate_pin {
+        linkage.add_joint(&mut b, LinkageJoint::O, "O duplicate");
+    }
+    linkage.add_joint(&mut b, LinkageJoint::A, "A");
+    linkage.add_joint(&mut b, LinkageJoint::B, "B");
+    if !duplicate_pin {
+        linkage.add_joint(&mut b, LinkageJoint::Slide, "slide");
+    }
+    b.add_driving(
+        "crank drive",
+        BodyId::Ground,
+        CrankSliderLinkage::CRANK,
+        motion,
+    )
+    .gravity(Vector2::new(0.0, -9.81));
+    b.build::<9>().expect("nine equations for nine coordinates")
+}
+
+/// Assembly guess for [`raw_crank_slider`] at φ = 0: everything laid along +x.
+pub fn guess(r: f64, l: f64) -> SVector<f64, 9> {
+    SVector::<f64, 9>::from_column_slice(&[
+        r / 2.0,
+        0.0,
+        0.0,
+        r + l / 2.0,
+        0.0,
+        0.0,
+        r + l,
+        0.0,
+        0.0,
+    ])
 }

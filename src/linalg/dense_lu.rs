@@ -1,6 +1,7 @@
 //! The crate's one small dense LU: solves with, and rank diagnosis of, the fixed-size
-//! constraint Jacobian ([`Factorization`]) and the iteration matrices `I − c J` of the
-//! implicit integrators (`crate::integrators`, dynamic size: [`DenseLu<Dyn>`](DenseLu)).
+//! constraint Jacobian of the multibody core (`crate::mechanism`, [`Factorization`]) and the
+//! iteration matrices `I − c J` of the implicit integrators (`crate::integrators`, dynamic
+//! size: [`DenseLu<Dyn>`](DenseLu)).
 //!
 //! From nalgebra (stack-allocated for `SMatrix`, no heap): the
 //! factorisations [`LU`] (partial row pivoting, P A = L U) and [`FullPivLU`]
