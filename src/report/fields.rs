@@ -10,10 +10,10 @@ use super::vtu::{VtuField, write_vtu};
 use crate::fem::cycle::{CycleSolution, UnitSolutions};
 use crate::fem::error::{FemError, Result};
 use crate::fem::estimate::ErrorEstimate;
-use crate::report::picture::{PictureOptions, render_tet10_field};
 use crate::fem::rod::{FemResult, LoadCaseResult, RodSolution};
 use crate::fem::stress::StressField;
 use crate::fem::{BoreSurface, TetMesh};
+use crate::report::picture::{PictureOptions, render_tet10_field};
 use crate::stages::records::DesignCycle;
 use std::path::Path;
 
