@@ -220,6 +220,28 @@ impl MassProperties {
         }
     }
 
+    /// From integrals computed elsewhere (e.g. OpenCASCADE's exact volume integrals of a STEP
+    /// solid): `volume`, `centroid` and the second-moment tensor about the centroid at unit
+    /// density, `inertia_unit_density` (I_ii = ∫ squared distance to axis i dV, I_ij = −∫ x_i x_j
+    /// dV), all in metres.
+    pub fn from_integrals(
+        volume: f64,
+        centroid: Vector3<f64>,
+        inertia_unit_density: Matrix3<f64>,
+        density: f64,
+    ) -> Self {
+        let inertia = inertia_unit_density * density;
+        let (principal_moments, principal_axes) = principal(&inertia);
+        MassProperties {
+            volume,
+            mass: volume * density,
+            centroid,
+            inertia,
+            principal_moments,
+            principal_axes,
+        }
+    }
+
     /// Moment of inertia about the axis through the centroid along the unit vector `axis`.
     pub fn moment_about(&self, axis: &Vector3<f64>) -> f64 {
         axis.dot(&(self.inertia * axis))

@@ -20,6 +20,7 @@ pub mod mechanism_frame;
 pub mod primitives;
 pub mod sidecar;
 pub mod simplify;
+pub mod step;
 pub mod stl_file;
 pub mod validate;
 pub mod weld;
