@@ -64,6 +64,14 @@ pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>>
     let ranking_csv = out.join("ranking.csv");
     write_atomic(&ranking_csv, &ranking::csv(results)?)?;
     let mut written = vec![json, md, csv_path, ranking, ranking_csv];
+    // a failure whose message was cut to one line keeps its whole log beside the reports
+    for f in &results.failed {
+        if let Some(log) = &f.log {
+            let path = out.join(file_safe(&f.id())).join("failure.log");
+            write_atomic(&path, log.as_bytes())?;
+            written.push(path);
+        }
+    }
     let histories = design_files::histories(results);
     for (id, design, h) in &histories {
         let dir = out.join(file_safe(id));

@@ -61,6 +61,38 @@ pub struct FailedDesign {
     /// Stage 2's pin-force history (written to its own CSV, not to `results.json`).
     #[serde(skip)]
     pub history: Option<DrivenResult>,
+    /// The whole message when `error` had to be cut to one line (a subprocess's log): written by
+    /// the report to `<id>/failure.log`, named in `error`.
+    #[serde(skip)]
+    pub log: Option<String>,
+}
+
+/// One line that says what failed, from a message that carries a subprocess's log (a failed
+/// gmsh run: "… exited with …" and its standard error): the first line (which names the file and
+/// the stage) and the log's last error line, and what to try for a mesher failure; `None` for
+/// any other message (kept whole).
+pub fn one_line(message: &str, log_name: &str) -> Option<String> {
+    if !message.contains(" exited with ") {
+        return None;
+    }
+    let mut lines = message.lines().filter(|l| !l.trim().is_empty());
+    let first = lines.next()?.trim_end_matches(':').to_string();
+    let rest: Vec<&str> = lines.collect();
+    if rest.is_empty() {
+        return None;
+    }
+    let cause = rest
+        .iter()
+        .rev()
+        .find(|l| l.contains("Error") || l.contains("error"))
+        .unwrap_or(rest.last().expect("not empty"))
+        .trim();
+    let hint = if message.contains("mesh_rod.py") || message.contains("gmsh") {
+        " — try: a fixed mesh (`fem.target_error = 0` or `--size`), a coarser or finer STL export, or a STEP export of the part"
+    } else {
+        ""
+    };
+    Some(format!("{first}: {cause}{hint} (full log: {log_name})"))
 }
 
 impl FailedDesign {
@@ -75,5 +107,25 @@ impl FailedDesign {
             },
             |m| m.id.clone(),
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::one_line;
+
+    #[test]
+    fn a_mesher_log_becomes_one_line_that_names_the_cause_and_the_log() {
+        let msg = "designs/x.stl: FEM: .venv/bin/python pipeline/mesh_rod.py exited with exit status: 1:\nInfo : Meshing surface 12\nInfo : Done\nError : Wrong topology of boundary mesh for parametrization\nTraceback: gmsh exception";
+        let line = one_line(msg, "x/failure.log").unwrap();
+        assert!(!line.contains('\n'), "{line}");
+        assert!(line.starts_with("designs/x.stl: FEM"), "{line}");
+        assert!(
+            line.contains("Wrong topology of boundary mesh for parametrization"),
+            "{line}"
+        );
+        assert!(line.contains("try:") && line.contains("x/failure.log"), "{line}");
+        // a one-line message stays as it is
+        assert_eq!(one_line("x.stl: not an STL file", "x/failure.log"), None);
     }
 }

@@ -5,7 +5,7 @@
 //! that its mesh and fields need not be held until the end.
 
 use super::cache::{Cache, design_key};
-use super::results::{DesignResult, FailedDesign, STAGES, StudyResults};
+use super::results::{DesignResult, FailedDesign, STAGES, StudyResults, one_line};
 use super::shard;
 use crate::config::StudyConfig;
 use crate::geometry::design::find_stl_files;
@@ -245,8 +245,15 @@ fn study_one(
         let _ = cache.put(&id, key, &entry);
     }
     let outcome = computed.map_err(|e| {
+        let full = format!("{e:#}");
+        let log_name = format!("{}/failure.log", file_safe(&id));
+        let (error, log) = match one_line(&full, &log_name) {
+            Some(line) => (line, Some(full)),
+            None => (full, None),
+        };
         Box::new(FailedDesign {
-            error: format!("{e:#}"),
+            error,
+            log,
             ..failed
         })
     });
