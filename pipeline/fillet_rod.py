@@ -10,6 +10,11 @@ parameters (no calibration), so the exact B-rep is known and reproducible.
       The STL exactly as the designs are exported (gmsh surface mesh, 150 elements per turn of
       curvature, 0.8-6 mm, welded by float32 value, outward, validated): what rodstudy meshes.
 
+  fillet_rod.py step OUT.step [--design N]
+      The exact B-rep of the same rod (or of design N) as a STEP file in mm, as a CAD system exports
+      it: the input of rodstudy's STEP route (exact mass properties, curved tet10 on the true
+      surfaces).
+
   fillet_rod.py reference OUT.msh --near H [--far 6] [--band 4] [--design N]
       A reference mesh made from the exact B-rep, independently of the STL route: curved 10-node
       tetrahedra (second-order nodes on the true fillets), element size H within BAND mm of the
@@ -76,6 +81,21 @@ def cmd_stl(args) -> dict:
             "params": p, "seconds": time.perf_counter() - t0}
 
 
+def cmd_step(args) -> dict:
+    """The exact B-rep of the fillet test rod as a STEP file (mm): what a CAD system would export."""
+    import gmsh
+
+    md = designs_module()
+    t0 = time.perf_counter()
+    d, p, vol = build(md, args.design)
+    out = pathlib.Path(args.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    gmsh.write(str(out))
+    exact = md.occ_properties(vol)
+    return {"step": str(out), "volume_mm3": float(exact["volume"]), "params": p,
+            "seconds": time.perf_counter() - t0}
+
+
 def fillet_surfaces(md, vol: int, p: dict) -> list:
     """Faces of the four shank-to-eye fillets: the curved faces whose xy extent is at most a fillet's
     (not the bores, not the eye outlines) beyond the bolt bosses."""
@@ -135,6 +155,9 @@ def main(argv=None) -> int:
     sub = ap.add_subparsers(dest="cmd", required=True)
     ps = sub.add_parser("stl")
     ps.add_argument("out")
+    pt = sub.add_parser("step")
+    pt.add_argument("out")
+    pt.add_argument("--design", type=int, help="design N of make_designs.py instead of the fillet test rod")
     pr = sub.add_parser("reference")
     pr.add_argument("out")
     pr.add_argument("--near", type=float, required=True)
@@ -142,7 +165,7 @@ def main(argv=None) -> int:
     pr.add_argument("--band", type=float, default=4.0)
     pr.add_argument("--design", type=int, help="design N of make_designs.py instead of the fillet test rod")
     args = ap.parse_args(argv)
-    info = {"stl": cmd_stl, "reference": cmd_reference}[args.cmd](args)
+    info = {"stl": cmd_stl, "step": cmd_step, "reference": cmd_reference}[args.cmd](args)
     print(json.dumps(info, sort_keys=True))
     return 0
 
