@@ -12,7 +12,10 @@ pub mod rod_mesher;
 pub mod rodmesh;
 pub mod size_field;
 
-pub use gmsh::{MeshReport, MeshRequest, MeshedRod, convert_mesh, mesh_stl, mesh_stl_with};
+pub use gmsh::{
+    MeshReport, MeshRequest, MeshedRod, StepInRodFrame, convert_mesh, mesh_step_with, mesh_stl,
+    mesh_stl_with,
+};
 pub use rod_mesher::GmshRodMesher;
 pub use rodmesh::{read_rodmesh, write_rodmesh};
 

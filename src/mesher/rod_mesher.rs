@@ -4,17 +4,23 @@
 
 use std::path::{Path, PathBuf};
 
-use super::gmsh::{MeshReport, MeshRequest, MeshedRod, mesh_stl, mesh_stl_with};
+use super::gmsh::{
+    MeshReport, MeshRequest, MeshedRod, StepInRodFrame, mesh_step_with, mesh_stl, mesh_stl_with,
+};
 use super::size_field::write_size_field;
 use crate::fem::adapt::{MeshAsk, Mesher};
 use crate::fem::error::{FemError, Result};
 use crate::fem::mesh::TetMesh;
 
-/// gmsh on one rod surface (an STL in millimetres, in the rod frame).
+/// gmsh on one rod: its surface (an STL in millimetres, in the rod frame), or the exact geometry
+/// of its STEP file moved into the rod frame.
 pub struct GmshRodMesher {
     python: PathBuf,
     script: PathBuf,
     stl: PathBuf,
+    /// The exact geometry, when the design is a STEP file: meshed instead of the STL, with curved
+    /// elements.
+    step: Option<StepInRodFrame>,
     /// Cache of gmsh's classified surface, shared by every mesh of this surface.
     geometry: PathBuf,
     work_dir: PathBuf,
@@ -44,11 +50,23 @@ impl GmshRodMesher {
             python: python.to_path_buf(),
             script: script.to_path_buf(),
             stl,
+            step: None,
             geometry: work_dir.join(format!("classified-{}.msh", &digest[..16])),
             work_dir: work_dir.to_path_buf(),
             label: label.to_string(),
             last_report: None,
         })
+    }
+
+    /// Meshes the exact geometry of `step` (curved tet10) instead of the STL surface.
+    pub fn with_step(mut self, step: StepInRodFrame) -> Self {
+        self.step = Some(step);
+        self
+    }
+
+    /// Whether the meshes are made from the exact geometry (a STEP file).
+    pub fn exact_geometry(&self) -> bool {
+        self.step.is_some()
     }
 
     /// One mesh of uniform size `size_mm` (with a size field: its cap) into `dir`.
@@ -58,6 +76,20 @@ impl GmshRodMesher {
         size_field: Option<&Path>,
         dir: &Path,
     ) -> Result<MeshedRod> {
+        if let Some(step) = &self.step {
+            return mesh_step_with(
+                &self.python,
+                &self.script,
+                step,
+                &MeshRequest {
+                    size_mm,
+                    size_field,
+                    geometry: None,
+                    name: Some("rod"),
+                },
+                dir,
+            );
+        }
         mesh_stl_with(
             &self.python,
             &self.script,
@@ -75,6 +107,9 @@ impl GmshRodMesher {
     /// One mesh of uniform size `size_mm` into `dir`, without the classified-surface cache (each
     /// size classifies the surface afresh, as a refinement study on its own wants).
     pub fn uncached(&self, size_mm: f64, dir: &Path) -> Result<MeshedRod> {
+        if self.step.is_some() {
+            return self.mesh_into(size_mm, None, dir);
+        }
         mesh_stl(&self.python, &self.script, &self.stl, size_mm, dir)
     }
 
