@@ -7,12 +7,14 @@
 //! - [`mass_properties`]: exact polyhedral integration (volume, centroid, inertia, principal axes);
 //! - [`sidecar`]: the optional `NAME.toml` beside a design (units, density, pins, name);
 //! - [`mechanism_frame`]: the rod's properties in the crank–slider frame (l1, offset, I_zz, I_xx);
+//! - [`bore_finder`]: the pin bores found from the surface (cylinder fits), when no sidecar gives them;
 //! - [`bore_check`]: ray casts proving each pin centre sits in a bore;
 //! - [`design`]: the whole stage for one design file, and its report record;
 //! - [`primitives`]: closed meshes with known properties, for tests and benchmarks;
 //! - [`error`]: the defects a file can have.
 
 pub mod bore_check;
+pub mod bore_finder;
 pub mod design;
 pub mod error;
 pub mod mass_properties;
