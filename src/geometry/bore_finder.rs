@@ -609,7 +609,7 @@ pub mod tests {
     /// z ∈ [−h/2, h/2], `n` segments per full turn (a multiple of 8); welded as the STL stores
     /// it, validated, in metres.
     pub fn plate(holes: &[Hole], s: f64, h: f64, n: usize) -> IndexedMesh {
-        assert!(n % 8 == 0);
+        assert!(n.is_multiple_of(8));
         let mut tris: Vec<[Vector2<f64>; 3]> = Vec::new();
         // right and left edge chains of each tile (bottom to top)
         let mut chains: Vec<(Vec<Vector2<f64>>, Vec<Vector2<f64>>)> = Vec::new();

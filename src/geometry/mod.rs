@@ -3,7 +3,8 @@
 //! The pipeline of this stage, one file per step:
 //! - [`stl_file`]: bytes → triangle soup (binary or ASCII, refusing what is not an STL);
 //! - [`weld`]: soup → indexed mesh, equal vertices merged by value;
-//! - [`validate`]: closed, manifold, consistently outward, one shell (or a precise error);
+//! - [`validate`]: closed, manifold, consistently outward (several bodies: one bonded body, with a
+//!   warning), or a precise error;
 //! - [`mass_properties`]: exact polyhedral integration (volume, centroid, inertia, principal axes);
 //! - [`sidecar`]: the optional `NAME.toml` beside a design (units, density, pins, name);
 //! - [`mechanism_frame`]: the rod's properties in the crank–slider frame (l1, offset, I_zz, I_xx);
