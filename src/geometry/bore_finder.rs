@@ -347,8 +347,9 @@ fn fit_cylinder(points: &[Vector3<f64>], axis: Vector3<f64>) -> Option<Cylinder>
     })
 }
 
-/// Smooth patches: triangle groups joined across manifold edges with small dihedral angles.
-fn smooth_patches(mesh: &IndexedMesh, normals: &[Vector3<f64>]) -> Vec<Vec<u32>> {
+/// Smooth patches: triangle groups joined across manifold edges with small dihedral angles;
+/// and each triangle's neighbours across its manifold edges (`u32::MAX`: none).
+fn smooth_patches(mesh: &IndexedMesh, normals: &[Vector3<f64>]) -> (Vec<Vec<u32>>, Vec<[u32; 3]>) {
     let n = mesh.triangles.len();
     let mut uses: Vec<(u64, u32)> = Vec::with_capacity(3 * n);
     for (t, &[a, b, c]) in mesh.triangles.iter().enumerate() {
@@ -366,7 +367,17 @@ fn smooth_patches(mesh: &IndexedMesh, normals: &[Vector3<f64>]) -> Vec<Vec<u32>>
         i
     }
     let cos_max = SMOOTH_ANGLE_DEG.to_radians().cos();
+    let mut neighbours = vec![[u32::MAX; 3]; n];
+    let mut link = |a: u32, b: u32| {
+        if let Some(slot) = neighbours[a as usize].iter_mut().find(|x| **x == u32::MAX) {
+            *slot = b;
+        }
+    };
     for group in uses.chunk_by(|x, y| x.0 == y.0) {
+        if let [(_, s), (_, t)] = *group {
+            link(s, t);
+            link(t, s);
+        }
         if let [(_, s), (_, t)] = *group
             && normals[s as usize].dot(&normals[t as usize]) >= cos_max
         {
@@ -386,7 +397,7 @@ fn smooth_patches(mesh: &IndexedMesh, normals: &[Vector3<f64>]) -> Vec<Vec<u32>>
         }
         patches[index[r] as usize].push(t);
     }
-    patches
+    (patches, neighbours)
 }
 
 /// A fitted concave cylindrical patch before merging.
@@ -415,54 +426,34 @@ pub fn find_bores(mesh: &IndexedMesh) -> Vec<Bore> {
         .collect();
     let normals: Vec<Vector3<f64>> = normals_areas.iter().map(|x| x.0).collect();
     let mut walls: Vec<Wall> = Vec::new();
-    for patch in smooth_patches(mesh, &normals) {
+    // whether a cylinder came out of splitting a smooth patch
+    let mut split = false;
+    let (patches, neighbours) = smooth_patches(mesh, &normals);
+    let mut patch_of = vec![0u32; mesh.triangles.len()];
+    for (k, p) in patches.iter().enumerate() {
+        for &t in p {
+            patch_of[t as usize] = k as u32;
+        }
+    }
+    for (k, patch) in patches.into_iter().enumerate() {
         if patch.len() < 4 {
             continue;
         }
-        let mut scatter = Matrix3::zeros();
-        let mut area = 0.0;
-        for &t in &patch {
-            let (n, a) = normals_areas[t as usize];
-            scatter += n * n.transpose() * a;
-            area += a;
-        }
-        if area <= 0.0 {
-            continue;
-        }
-        let eig = SymmetricEigen::new(scatter / area);
-        let mut order = [0usize, 1, 2];
-        order.sort_by(|&i, &j| eig.eigenvalues[i].total_cmp(&eig.eigenvalues[j]));
-        let (l0, l1) = (eig.eigenvalues[order[0]], eig.eigenvalues[order[1]]);
-        if l0 > MAX_OFF_AXIS_SHARE || l1 < MIN_CURVED_SHARE {
-            continue;
-        }
-        let axis: Vector3<f64> = eig.eigenvectors.column(order[0]).into_owned();
-        let points = patch_vertices(mesh, &patch);
-        let Some(cyl) = fit_cylinder(&points, axis) else {
-            continue;
-        };
-        if cyl.rms > MAX_RESIDUAL_REL * cyl.radius {
-            continue;
-        }
-        // normals towards the axis: a bore's wall, not a boss
-        let mut facing = 0.0;
-        for &t in &patch {
-            let [a, b, c] = mesh.corners(t as usize);
-            let d = (a + b + c) / 3.0 - cyl.origin;
-            let radial = d - cyl.axis * cyl.axis.dot(&d);
-            if let Some(r) = radial.try_normalize(0.0) {
-                let (n, ar) = normals_areas[t as usize];
-                facing += n.dot(&r) * ar;
+        match wall_of(mesh, &normals_areas, patch) {
+            Ok(w) => walls.push(w),
+            Err((patch, true)) => {
+                // a smooth patch of several surfaces (a bore whose rims are rounded into the
+                // faces): the cylinders in it, one by one
+                let inside = |t: u32| patch_of[t as usize] == k as u32;
+                for part in cylinders_in(mesh, &normals_areas, &neighbours, &patch, inside) {
+                    if let Ok(w) = wall_of(mesh, &normals_areas, part) {
+                        walls.push(w);
+                        split = true;
+                    }
+                }
             }
+            Err(_) => {}
         }
-        if facing / area > -0.5 {
-            continue;
-        }
-        walls.push(Wall {
-            cyl,
-            triangles: patch,
-            area,
-        });
     }
     // merge coaxial walls of equal radius
     let mut groups: Vec<Vec<usize>> = Vec::new();
@@ -493,11 +484,241 @@ pub fn find_bores(mesh: &IndexedMesh) -> Vec<Bore> {
             } else {
                 fit_cylinder(&patch_vertices(mesh, &triangles), walls[g[0]].cyl.axis)?
             };
-            Some(describe_wall(mesh, &cyl, &triangles, area))
+            if !split {
+                return Some(describe_wall(mesh, &cyl, &triangles, area));
+            }
+            // pieces of a wall the growth left out (small strips between regions, which are not
+            // curved enough to stand alone): every facet on the cylinder, facing its axis
+            let mut all = triangles;
+            all.extend(on_cylinder(mesh, &normals_areas, &cyl));
+            all.sort_unstable();
+            all.dedup();
+            let area = all.iter().map(|&t| normals_areas[t as usize].1).sum();
+            // the rounds the wall runs into are tangent to it: trim the vertices that leave the
+            // cylinder by more than rounding, refit, and take the axial extent from those left
+            let mut points = patch_vertices(mesh, &all);
+            let mut cyl = fit_cylinder(&points, cyl.axis)?;
+            let noise =
+                points.iter().map(|p| p.amax()).fold(0.0, f64::max) * 4.0 * f32::EPSILON as f64;
+            for rel in [1e-4, 1e-5] {
+                points.retain(|p| {
+                    let d = p - cyl.origin;
+                    ((d - cyl.axis * cyl.axis.dot(&d)).norm() - cyl.radius).abs()
+                        <= rel * cyl.radius + noise
+                });
+                cyl = fit_cylinder(&points, cyl.axis)?;
+            }
+            let mut bore = describe_wall(mesh, &cyl, &all, area);
+            let a = Vector3::from(bore.axis);
+            let (lo, hi) = points
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                    let w = (p - cyl.origin).dot(&a);
+                    (lo.min(w), hi.max(w))
+                });
+            bore.centre = (cyl.origin + a * ((lo + hi) / 2.0)).into();
+            bore.length = hi - lo;
+            Some(bore)
         })
         .collect();
     bores.sort_by(|a, b| b.area.total_cmp(&a.area));
     bores
+}
+
+/// The concave cylinder a patch is, or the patch back with whether it is curved but not one
+/// cylinder (worth splitting).
+fn wall_of(
+    mesh: &IndexedMesh,
+    normals_areas: &[(Vector3<f64>, f64)],
+    patch: Vec<u32>,
+) -> Result<Wall, (Vec<u32>, bool)> {
+    let Some((l0, l1, axis, area)) = scatter_axis(normals_areas, &patch) else {
+        return Err((patch, false));
+    };
+    if l1 < MIN_CURVED_SHARE {
+        return Err((patch, false));
+    }
+    if l0 > MAX_OFF_AXIS_SHARE {
+        return Err((patch, true));
+    }
+    let points = patch_vertices(mesh, &patch);
+    let Some(cyl) = fit_cylinder(&points, axis) else {
+        return Err((patch, true));
+    };
+    if cyl.rms > MAX_RESIDUAL_REL * cyl.radius {
+        return Err((patch, true));
+    }
+    // normals towards the axis: a bore's wall, not a boss
+    let mut facing = 0.0;
+    for &t in &patch {
+        let [a, b, c] = mesh.corners(t as usize);
+        let d = (a + b + c) / 3.0 - cyl.origin;
+        let radial = d - cyl.axis * cyl.axis.dot(&d);
+        if let Some(r) = radial.try_normalize(0.0) {
+            let (n, ar) = normals_areas[t as usize];
+            facing += n.dot(&r) * ar;
+        }
+    }
+    if facing / area > -0.5 {
+        return Err((patch, false));
+    }
+    Ok(Wall {
+        cyl,
+        triangles: patch,
+        area,
+    })
+}
+
+/// (smallest, middle eigenvalue, smallest eigenvector, area) of the area-weighted normal
+/// scatter Σ A n nᵀ / Σ A of some triangles.
+fn scatter_axis(
+    normals_areas: &[(Vector3<f64>, f64)],
+    triangles: &[u32],
+) -> Option<(f64, f64, Vector3<f64>, f64)> {
+    let mut scatter = Matrix3::zeros();
+    let mut area = 0.0;
+    for &t in triangles {
+        let (n, a) = normals_areas[t as usize];
+        scatter += n * n.transpose() * a;
+        area += a;
+    }
+    if area <= 0.0 {
+        return None;
+    }
+    let eig = SymmetricEigen::new(scatter / area);
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|&i, &j| eig.eigenvalues[i].total_cmp(&eig.eigenvalues[j]));
+    let axis: Vector3<f64> = eig.eigenvectors.column(order[0]).into_owned();
+    Some((
+        eig.eigenvalues[order[0]],
+        eig.eigenvalues[order[1]],
+        axis,
+        area,
+    ))
+}
+
+/// Largest tilt of a facet normal out of the plane ⟂ to a cylinder's axis, when growing [deg].
+const GROW_TILT_DEG: f64 = 6.0;
+/// Largest distance of a facet's corners from a cylinder when growing, relative to its radius.
+const GROW_DISTANCE_REL: f64 = 1e-3;
+
+/// The cylindrical regions of a smooth patch that is not one cylinder (e.g. a bore whose rims
+/// are rounded into the faces): from each seed triangle not yet taken, a cylinder is fitted to
+/// its two rings of neighbours and grown across neighbours whose corners lie on it (within
+/// [`GROW_DISTANCE_REL`]) and whose normals are ⟂ to its axis (within [`GROW_TILT_DEG`]),
+/// refitted once to the grown region and grown again.
+fn cylinders_in(
+    mesh: &IndexedMesh,
+    normals_areas: &[(Vector3<f64>, f64)],
+    neighbours: &[[u32; 3]],
+    patch: &[u32],
+    inside: impl Fn(u32) -> bool,
+) -> Vec<Vec<u32>> {
+    use std::collections::HashSet;
+    let mut taken: HashSet<u32> = HashSet::new();
+    let mut parts = Vec::new();
+    let next_to = |t: u32| {
+        neighbours[t as usize]
+            .into_iter()
+            .filter(|&s| s != u32::MAX && inside(s))
+    };
+    let max_tilt = GROW_TILT_DEG.to_radians().sin();
+    for &seed in patch {
+        if taken.contains(&seed) {
+            continue;
+        }
+        // two rings around the seed
+        let mut ring = vec![seed];
+        for depth in 0..2 {
+            let _ = depth;
+            let now = ring.clone();
+            for t in now {
+                for s in next_to(t) {
+                    if !ring.contains(&s) && !taken.contains(&s) {
+                        ring.push(s);
+                    }
+                }
+            }
+        }
+        if ring.len() < 6 {
+            continue;
+        }
+        let Some((l0, l1, axis, _)) = scatter_axis(normals_areas, &ring) else {
+            continue;
+        };
+        if l1 < 1e-4 || l0 > 0.1 * l1 {
+            continue;
+        }
+        let Some(mut cyl) = fit_cylinder(&patch_vertices(mesh, &ring), axis) else {
+            continue;
+        };
+        let mut region: Vec<u32> = Vec::new();
+        for round in 0..2 {
+            let fits = |t: u32, cyl: &Cylinder| {
+                let n = normals_areas[t as usize].0;
+                n.dot(&cyl.axis).abs() <= max_tilt
+                    && mesh.corners(t as usize).iter().all(|p| {
+                        let d = p - cyl.origin;
+                        ((d - cyl.axis * cyl.axis.dot(&d)).norm() - cyl.radius).abs()
+                            <= GROW_DISTANCE_REL * cyl.radius
+                    })
+            };
+            if !fits(seed, &cyl) {
+                break;
+            }
+            let mut member: HashSet<u32> = HashSet::from([seed]);
+            let mut queue = vec![seed];
+            while let Some(t) = queue.pop() {
+                for s in next_to(t) {
+                    if !taken.contains(&s) && !member.contains(&s) && fits(s, &cyl) {
+                        member.insert(s);
+                        queue.push(s);
+                    }
+                }
+            }
+            region = member.into_iter().collect();
+            region.sort_unstable();
+            if round == 0 {
+                match fit_cylinder(&patch_vertices(mesh, &region), cyl.axis) {
+                    Some(c) if c.rms <= MAX_RESIDUAL_REL * c.radius => cyl = c,
+                    _ => break,
+                }
+            }
+        }
+        if region.len() >= 6 {
+            taken.extend(region.iter().copied());
+            parts.push(region);
+        }
+    }
+    parts
+}
+
+/// Every facet whose corners lie on `cyl` (within [`GROW_DISTANCE_REL`]) and whose normal
+/// points at its axis (within [`GROW_TILT_DEG`]).
+fn on_cylinder(
+    mesh: &IndexedMesh,
+    normals_areas: &[(Vector3<f64>, f64)],
+    cyl: &Cylinder,
+) -> Vec<u32> {
+    let cos_tilt = GROW_TILT_DEG.to_radians().cos();
+    (0..mesh.triangles.len() as u32)
+        .filter(|&t| {
+            let c = mesh.corners(t as usize);
+            let radial = |p: &Vector3<f64>| {
+                let d = p - cyl.origin;
+                d - cyl.axis * cyl.axis.dot(&d)
+            };
+            if !c
+                .iter()
+                .all(|p| (radial(p).norm() - cyl.radius).abs() <= GROW_DISTANCE_REL * cyl.radius)
+            {
+                return false;
+            }
+            let mid = radial(&((c[0] + c[1] + c[2]) / 3.0));
+            mid.try_normalize(0.0)
+                .is_some_and(|r| normals_areas[t as usize].0.dot(&r) <= -cos_tilt)
+        })
+        .collect()
 }
 
 /// The distinct vertices of some triangles.
@@ -612,7 +833,8 @@ pub mod tests {
         assert!(n.is_multiple_of(8));
         let mut tris: Vec<[Vector2<f64>; 3]> = Vec::new();
         // right and left edge chains of each tile (bottom to top)
-        let mut chains: Vec<(Vec<Vector2<f64>>, Vec<Vector2<f64>>)> = Vec::new();
+        type Chain = Vec<Vector2<f64>>;
+        let mut chains: Vec<(Chain, Chain)> = Vec::new();
         for hole in holes {
             let c = Vector2::new(hole.x, 0.0);
             let ks: Vec<i64> = if hole.half {
