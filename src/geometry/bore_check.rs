@@ -19,7 +19,7 @@ use anyhow::{Result, bail};
 use nalgebra::Vector3;
 
 /// Number of in-plane ray directions (every 30°).
-const IN_PLANE_RAYS: usize = 12;
+pub const IN_PLANE_RAYS: usize = 12;
 
 /// The rod's surface for the bore queries.
 pub struct RodSurface<'a> {
@@ -89,8 +89,49 @@ impl<'a> RodSurface<'a> {
         units: &str,
     ) -> Result<f64> {
         let hint = "check the STL units (sidecar `units`, default mm) and the pin centres (sidecar `crank_pin`, `piston_pin`)";
-        let shown = centre / scale;
-        let at = format!("({:.3}, {:.3}, {:.3}) {units}", shown.x, shown.y, shown.z);
+        let at = shown(centre, scale, units);
+        let probe = self.probe(centre, axis);
+        probe.axis_clear(pin, &at, scale, units, hint)?;
+        let mut radius = f64::INFINITY;
+        for hit in &probe.in_plane {
+            match hit {
+                Some(t) => radius = radius.min(*t),
+                None => bail!(
+                    "the {pin} centre {at} is not inside a bore: a ray across the pin axis leaves the part without touching it (the centre lies outside the rod): {hint}"
+                ),
+            }
+        }
+        Ok(radius)
+    }
+
+    /// Checks that `centre` lies on the axis of a partial bore (an arc open on one side, e.g. a
+    /// big end without its cap, found by [`super::bore_finder`]): not inside material and no
+    /// material along the pin axis through it. The in-plane rays that leave through the opening
+    /// are expected; the bore radius is the one fitted to the arc. Returns the number of
+    /// in-plane directions (of [`IN_PLANE_RAYS`]) that meet the wall.
+    pub fn partial_bore(
+        &self,
+        pin: &str,
+        centre: Vector3<f64>,
+        axis: Vector3<f64>,
+        scale: f64,
+        units: &str,
+    ) -> Result<usize> {
+        let hint = "check the STL units (sidecar `units`, default mm) and the pin centres (sidecar `crank_pin`, `piston_pin`)";
+        let at = shown(centre, scale, units);
+        let probe = self.probe(centre, axis);
+        probe.axis_clear(pin, &at, scale, units, hint)?;
+        let hits = probe.in_plane.iter().filter(|h| h.is_some()).count();
+        if hits == 0 {
+            bail!(
+                "the {pin} centre {at} is not inside a bore: no ray across the pin axis touches the part: {hint}"
+            );
+        }
+        Ok(hits)
+    }
+
+    /// The ray casts from `centre`: containment, the axis line both ways, the in-plane rays.
+    pub fn probe(&self, centre: Vector3<f64>, axis: Vector3<f64>) -> BoreProbe {
         let axis = axis.normalize();
         let u = axis
             .cross(&if axis.x.abs() < 0.9 {
@@ -141,30 +182,58 @@ impl<'a> RodSurface<'a> {
             .iter()
             .filter(|[a, b]| hits((axis + u * *a + v * *b).normalize(), &on_axis).len() % 2 == 1)
             .count();
-        if odd >= 2 {
+        let along_axis = [axis, -axis].map(|dir| hits(dir, &on_axis).into_iter().reduce(f64::min));
+        let in_plane = (0..IN_PLANE_RAYS)
+            .map(|k| {
+                let angle = std::f64::consts::TAU * k as f64 / IN_PLANE_RAYS as f64;
+                let dir = u * angle.cos() + v * angle.sin();
+                hits(dir, &across_plane).into_iter().reduce(f64::min)
+            })
+            .collect();
+        BoreProbe {
+            inside: odd >= 2,
+            along_axis,
+            in_plane,
+        }
+    }
+}
+
+/// A point in the file's units, as messages show it.
+fn shown(centre: Vector3<f64>, scale: f64, units: &str) -> String {
+    let p = centre / scale;
+    format!("({:.3}, {:.3}, {:.3}) {units}", p.x, p.y, p.z)
+}
+
+/// What the rays from a pin centre met (distances in the mesh's units).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BoreProbe {
+    /// The centre is inside material (the majority of the three containment rays).
+    pub inside: bool,
+    /// The nearest hit along +axis and along −axis.
+    pub along_axis: [Option<f64>; 2],
+    /// The nearest hit in each of the [`IN_PLANE_RAYS`] directions across the axis.
+    pub in_plane: Vec<Option<f64>>,
+}
+
+impl BoreProbe {
+    /// Refuses a centre in material or with material along its axis (the messages of
+    /// [`RodSurface::bore_radius`]).
+    fn axis_clear(&self, pin: &str, at: &str, scale: f64, units: &str, hint: &str) -> Result<()> {
+        if self.inside {
             bail!("the {pin} centre {at} lies inside material, not in a bore: {hint}");
         }
-        for dir in [axis, -axis] {
-            let h = hits(dir, &on_axis);
-            if let Some(t) = h.into_iter().reduce(f64::min) {
-                bail!(
-                    "a ray along the pin axis from the {pin} centre {at} hits material after {:.3} {units}: there is no through-bore at the pin: {hint}",
-                    t / scale
-                );
-            }
+        if let Some(t) = self.along_axis.iter().flatten().next() {
+            bail!(
+                "a ray along the pin axis from the {pin} centre {at} hits material after {:.3} {units}: there is no through-bore at the pin: {hint}",
+                t / scale
+            );
         }
-        let mut radius = f64::INFINITY;
-        for k in 0..IN_PLANE_RAYS {
-            let angle = std::f64::consts::TAU * k as f64 / IN_PLANE_RAYS as f64;
-            let dir = u * angle.cos() + v * angle.sin();
-            match hits(dir, &across_plane).into_iter().reduce(f64::min) {
-                Some(t) => radius = radius.min(t),
-                None => bail!(
-                    "the {pin} centre {at} is not inside a bore: a ray across the pin axis leaves the part without touching it (the centre lies outside the rod): {hint}"
-                ),
-            }
-        }
-        Ok(radius)
+        Ok(())
+    }
+
+    /// Share of the in-plane rays that leave the part without meeting it.
+    pub fn open_share(&self) -> f64 {
+        self.in_plane.iter().filter(|h| h.is_none()).count() as f64 / self.in_plane.len() as f64
     }
 }
 

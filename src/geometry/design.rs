@@ -1,7 +1,21 @@
-//! Stage 1 for one design file: read, weld, validate, integrate, map to the mechanism frame,
-//! check the bores, and the record that reports it.
+//! Stage 1 for one design file: read, weld, validate, integrate, place the pins (from the
+//! sidecar, else found from the geometry), map to the mechanism frame, check the bores, and the
+//! record that reports it.
+//!
+//! Pins: values in the sidecar always win. When it gives neither pin, [`find_pins`] looks for the
+//! two pin bores (restricted to the sidecar's `pin_axis` if given). A rod without any cylindrical
+//! bore (e.g. square bores) falls back to the spec's mechanism (A at the origin, B 180 mm along
+//! x, axis z), which the bore check then has to accept; any other refusal of the finder (one
+//! bore, three candidates, axes not parallel, equal radii) is an error of [`mass_of_design`] (and
+//! a warning of [`mass_of_solid`]). A pin in a partial bore (an arc open on one side: a big end
+//! modelled without its cap) is accepted when the finder measured that arc: the ray along the
+//! pin axis must still be clear, the radius is the arc's fitted radius, and a warning says the
+//! loads act on the existing arc. Sidecar pins whose in-plane rays leave the part get the same
+//! treatment if a partial bore's axis passes through them. The arcs are reported in
+//! [`PinsReport`]: 360 for a bore the in-plane rays find closed, the finder's measure otherwise.
 
 use super::bore_check::RodSurface;
+use super::bore_finder::{Bore, FoundPins, PinSearchError, find_bores, find_pins};
 use super::mass_properties::MassProperties;
 use super::mechanism_frame::{MechanismFrame, RodInFrame};
 use super::sidecar::DesignSettings;
@@ -9,6 +23,7 @@ use super::stl_file::{StlFormat, read_stl_file};
 use super::validate::validate;
 use super::weld::{IndexedMesh, weld};
 use anyhow::{Context, Result, bail};
+use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -25,7 +40,78 @@ pub struct LoadedDesign {
     pub mesh: IndexedMesh,
     pub mass: MassProperties,
     pub frame: MechanismFrame,
+    /// Where the pins came from and where they are.
+    pub pins: Pins,
     pub warnings: Vec<String>,
+}
+
+/// Where a design's pin centres came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum PinsSource {
+    /// Given in the sidecar.
+    #[default]
+    Sidecar,
+    /// Found from the geometry by [`find_pins`].
+    Found,
+    /// No sidecar pins and no cylindrical bore to find: the spec's mechanism.
+    Default,
+}
+
+/// The pins of a loaded design (metres).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Pins {
+    pub crank_m: Vector3<f64>,
+    pub piston_m: Vector3<f64>,
+    /// Unit pin axis.
+    pub axis: Vector3<f64>,
+    pub source: PinsSource,
+    /// The bores, when found from the geometry.
+    pub found: Option<FoundPins>,
+    /// Why the finder gave no pins, when it was asked and refused.
+    pub search_error: Option<PinSearchError>,
+}
+
+/// What the record says about the pins (see the module documentation). Serialized in the
+/// mass record only when it says something the sidecar did not: pins found from the geometry
+/// or taken from the spec's default, or a partial bore.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PinsReport {
+    /// `sidecar`, `found` or `default`.
+    pub pins_source: PinsSource,
+    pub crank_pin_file_units: [f64; 3],
+    pub piston_pin_file_units: [f64; 3],
+    pub pin_axis: [f64; 3],
+    /// Arc of the crank bore A [deg]: 360 for a full bore.
+    pub crank_bore_arc_deg: f64,
+    /// Arc of the piston bore B [deg].
+    pub piston_bore_arc_deg: f64,
+    /// The bores as the finder measured them (metres), when found.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub found: Option<FoundPins>,
+}
+
+impl Default for PinsReport {
+    fn default() -> Self {
+        PinsReport {
+            pins_source: PinsSource::Sidecar,
+            crank_pin_file_units: [f64::NAN; 3],
+            piston_pin_file_units: [f64::NAN; 3],
+            pin_axis: [f64::NAN; 3],
+            crank_bore_arc_deg: 360.0,
+            piston_bore_arc_deg: 360.0,
+            found: None,
+        }
+    }
+}
+
+impl PinsReport {
+    /// Pins from the sidecar sitting in full bores: nothing to add to the record's JSON.
+    pub fn says_nothing_new(&self) -> bool {
+        self.pins_source == PinsSource::Sidecar
+            && self.crank_bore_arc_deg == 360.0
+            && self.piston_bore_arc_deg == 360.0
+    }
 }
 
 /// The mass-stage record of one design, as written to JSON (SI units; see README "mass").
@@ -58,6 +144,9 @@ pub struct DesignMass {
     pub crank_bore_radius_m: f64,
     pub piston_bore_radius_m: f64,
     pub warnings: Vec<String>,
+    /// Where the pins came from; in the JSON only when found, defaulted or in a partial bore.
+    #[serde(default, skip_serializing_if = "PinsReport::says_nothing_new")]
+    pub pins: PinsReport,
 }
 
 /// The design name: the sidecar's `name`, else the file stem.
@@ -79,12 +168,8 @@ pub fn load_design(stl: &Path) -> Result<LoadedDesign> {
     let scale = settings.units.to_metres();
     let mesh = valid.mesh.scaled(scale);
     let mass = MassProperties::of_mesh(&mesh, settings.density);
-    let frame = MechanismFrame::new(
-        settings.crank_pin_m,
-        settings.piston_pin_m,
-        settings.pin_axis,
-    )
-    .with_context(file)?;
+    let pins = place_pins(&settings, &mesh);
+    let frame = MechanismFrame::new(pins.crank_m, pins.piston_m, pins.axis).with_context(file)?;
     let (lo, hi) = PLAUSIBLE_MASS_KG;
     if !(lo..=hi).contains(&mass.mass) {
         warnings.push(format!(
@@ -101,8 +186,45 @@ pub fn load_design(stl: &Path) -> Result<LoadedDesign> {
         mesh,
         mass,
         frame,
+        pins,
         warnings,
     })
+}
+
+/// The pins: the sidecar's, else found from the geometry, else (no cylindrical bore at all)
+/// the spec's default.
+fn place_pins(settings: &DesignSettings, mesh: &IndexedMesh) -> Pins {
+    if let (Some(crank_m), Some(piston_m)) = (settings.crank_pin_m, settings.piston_pin_m) {
+        return Pins {
+            crank_m,
+            piston_m,
+            axis: settings.pin_axis.unwrap_or_else(Vector3::z),
+            source: PinsSource::Sidecar,
+            found: None,
+            search_error: None,
+        };
+    }
+    match find_pins(mesh, settings.pin_axis, settings.units) {
+        Ok(f) => Pins {
+            crank_m: f.crank.centre_v(),
+            piston_m: f.piston.centre_v(),
+            axis: Vector3::from(f.axis),
+            source: PinsSource::Found,
+            found: Some(f),
+            search_error: None,
+        },
+        Err(e) => {
+            let (crank_m, piston_m, axis) = settings.default_pins();
+            Pins {
+                crank_m,
+                piston_m,
+                axis,
+                source: PinsSource::Default,
+                found: None,
+                search_error: Some(e),
+            }
+        }
+    }
 }
 
 /// Stage 1 for one file: [`load_design`], the bore check, and the report record. A solid whose
@@ -140,18 +262,37 @@ pub fn solid_mass(d: &LoadedDesign) -> DesignMass {
     }
 }
 
+/// What the bore check measured of one pin.
+struct PinBore {
+    radius: f64,
+    arc_deg: f64,
+}
+
 /// The bore check and the mechanism frame of a loaded design.
 fn rod_record(d: &LoadedDesign, stl: &Path) -> Result<DesignMass> {
-    let surface = RodSurface::new(&d.mesh).with_context(|| stl.display().to_string())?;
-    let scale = d.settings.units.to_metres();
-    let units = d.settings.units.symbol();
-    let bore = |pin: &str, centre| {
-        surface
-            .bore_radius(pin, centre, d.frame.z, scale, units)
-            .with_context(|| stl.display().to_string())
+    let file = || stl.display().to_string();
+    if let Some(e) = &d.pins.search_error
+        && !matches!(e, PinSearchError::NoBore(_))
+    {
+        bail!(
+            "{}: the pins cannot be found from the geometry: {e}",
+            stl.display()
+        );
+    }
+    let surface = RodSurface::new(&d.mesh).with_context(file)?;
+    let mut warnings = Vec::new();
+    let crank = pin_bore(d, &surface, Pin::Crank, &mut warnings).with_context(file);
+    let crank = match (crank, &d.pins.search_error) {
+        (Err(e), Some(why)) => {
+            return Err(e.context(format!(
+                "{}: the sidecar gives no pins and none were found from the geometry ({why}); the spec's default pins (A at the origin, B 180 mm along x, axis {}) do not sit in bores either",
+                stl.display(),
+                axis_name(d.pins.axis)
+            )));
+        }
+        (r, _) => r?,
     };
-    let crank_bore = bore("crank pin (A)", d.settings.crank_pin_m)?;
-    let piston_bore = bore("piston pin (B)", d.settings.piston_pin_m)?;
+    let piston = pin_bore(d, &surface, Pin::Piston, &mut warnings).with_context(file)?;
     let rod = RodInFrame::new(&d.frame, &d.mass);
     if !(rod.l1_m > 0.0 && rod.l1_m < rod.centre_distance_m) {
         bail!(
@@ -161,7 +302,102 @@ fn rod_record(d: &LoadedDesign, stl: &Path) -> Result<DesignMass> {
             rod.centre_distance_m
         );
     }
-    Ok(record(d, stl, Some((rod, crank_bore, piston_bore))))
+    let mut r = record(d, stl, Some((rod, crank.radius, piston.radius)));
+    r.pins.crank_bore_arc_deg = crank.arc_deg;
+    r.pins.piston_bore_arc_deg = piston.arc_deg;
+    r.warnings.extend(warnings);
+    Ok(r)
+}
+
+fn axis_name(a: Vector3<f64>) -> String {
+    match [a.x, a.y, a.z] {
+        [1.0, 0.0, 0.0] => "x".into(),
+        [0.0, 1.0, 0.0] => "y".into(),
+        [0.0, 0.0, 1.0] => "z".into(),
+        _ => format!("({:.4}, {:.4}, {:.4})", a.x, a.y, a.z),
+    }
+}
+
+#[derive(Clone, Copy, PartialEq)]
+enum Pin {
+    Crank,
+    Piston,
+}
+
+/// The bore check of one pin: a full bore by the in-plane rays; a partial bore (found, or met by
+/// sidecar pins whose in-plane rays leave the part) by the axis ray and the arc's fit.
+fn pin_bore(
+    d: &LoadedDesign,
+    surface: &RodSurface,
+    pin: Pin,
+    warnings: &mut Vec<String>,
+) -> Result<PinBore> {
+    let scale = d.settings.units.to_metres();
+    let units = d.settings.units.symbol();
+    let axis = d.frame.z;
+    let (name, centre, end, letter) = match pin {
+        Pin::Crank => ("crank pin (A)", d.pins.crank_m, "big end", "A"),
+        Pin::Piston => ("piston pin (B)", d.pins.piston_m, "small end", "B"),
+    };
+    let found = d.pins.found.as_ref().map(|f| match pin {
+        Pin::Crank => &f.crank,
+        Pin::Piston => &f.piston,
+    });
+    let partial = |bore: &Bore, warnings: &mut Vec<String>| -> Result<PinBore> {
+        surface.partial_bore(name, centre, axis, scale, units)?;
+        warnings.push(format!(
+            "{end} without cap: loads on the existing arc ({:.0}°)",
+            bore.arc_deg
+        ));
+        Ok(PinBore {
+            radius: bore.radius,
+            arc_deg: bore.arc_deg,
+        })
+    };
+    if let Some(bore) = found
+        && !bore.full
+    {
+        return partial(bore, warnings);
+    }
+    match surface.bore_radius(name, centre, axis, scale, units) {
+        Ok(radius) => Ok(PinBore {
+            radius,
+            arc_deg: 360.0,
+        }),
+        Err(e)
+            if d.pins.source == PinsSource::Sidecar
+                && surface.probe(centre, axis).open_share() > 0.0 =>
+        {
+            // sidecar pins in an open arc? measure the partial bores
+            let near = find_bores(&d.mesh)
+                .into_iter()
+                .filter(|b| !b.full && b.axis_v().dot(&axis).abs() > 1f64.to_radians().cos())
+                .min_by(|a, b| {
+                    a.distance_from_axis(centre)
+                        .total_cmp(&b.distance_from_axis(centre))
+                });
+            let Some(bore) = near else { return Err(e) };
+            let off = bore.distance_from_axis(centre);
+            let c = bore.centre_v() / scale;
+            let what = format!(
+                "{end} without cap: bore {letter} is an arc of {:.0}° (open on one side), radius {:.3} {units}, axis through ({:.3}, {:.3}, {:.3}) {units}",
+                bore.arc_deg,
+                bore.radius / scale,
+                c.x,
+                c.y,
+                c.z
+            );
+            if off <= 0.01 * bore.radius {
+                partial(&bore, warnings)
+            } else {
+                bail!(
+                    "{what}; the sidecar's {name} is {:.3} {units} away from that axis: correct the pin centre in the sidecar",
+                    off / scale
+                )
+            }
+        }
+        Err(e) => Err(e),
+    }
 }
 
 /// The record; the mechanism-frame fields NaN when `rod` is `None`.
@@ -173,6 +409,8 @@ fn record(d: &LoadedDesign, stl: &Path, rod: Option<(RodInFrame, f64, f64)>) -> 
         None => (None, nan, nan),
     };
     let pick = |f: fn(&RodInFrame) -> f64| rod.as_ref().map_or(nan, f);
+    let scale = d.settings.units.to_metres();
+    let in_file = |p: Vector3<f64>| (p / scale).into();
     DesignMass {
         design: d.name.clone(),
         id: stl
@@ -201,6 +439,15 @@ fn record(d: &LoadedDesign, stl: &Path, rod: Option<(RodInFrame, f64, f64)>) -> 
         crank_bore_radius_m: crank_bore,
         piston_bore_radius_m: piston_bore,
         warnings: d.warnings.clone(),
+        pins: PinsReport {
+            pins_source: d.pins.source,
+            crank_pin_file_units: in_file(d.pins.crank_m),
+            piston_pin_file_units: in_file(d.pins.piston_m),
+            pin_axis: d.pins.axis.into(),
+            crank_bore_arc_deg: d.pins.found.as_ref().map_or(360.0, |f| f.crank.arc_deg),
+            piston_bore_arc_deg: d.pins.found.as_ref().map_or(360.0, |f| f.piston.arc_deg),
+            found: d.pins.found.clone(),
+        },
     }
 }
 

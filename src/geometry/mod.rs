@@ -3,16 +3,19 @@
 //! The pipeline of this stage, one file per step:
 //! - [`stl_file`]: bytes → triangle soup (binary or ASCII, refusing what is not an STL);
 //! - [`weld`]: soup → indexed mesh, equal vertices merged by value;
-//! - [`validate`]: closed, manifold, consistently outward, one shell (or a precise error);
+//! - [`validate`]: closed, manifold, consistently outward (several bodies: one bonded body, with a
+//!   warning), or a precise error;
 //! - [`mass_properties`]: exact polyhedral integration (volume, centroid, inertia, principal axes);
 //! - [`sidecar`]: the optional `NAME.toml` beside a design (units, density, pins, name);
 //! - [`mechanism_frame`]: the rod's properties in the crank–slider frame (l1, offset, I_zz, I_xx);
+//! - [`bore_finder`]: the pin bores found from the surface (cylinder fits), when no sidecar gives them;
 //! - [`bore_check`]: ray casts proving each pin centre sits in a bore;
 //! - [`design`]: the whole stage for one design file, and its report record;
 //! - [`primitives`]: closed meshes with known properties, for tests and benchmarks;
 //! - [`error`]: the defects a file can have.
 
 pub mod bore_check;
+pub mod bore_finder;
 pub mod design;
 pub mod error;
 pub mod mass_properties;

@@ -1,10 +1,14 @@
 //! The optional sidecar `NAME.toml` beside `NAME.stl` (SPEC "Sidecar").
 //!
 //! Keys: `name` (display name), `units` (`mm` default, `cm`, `m`, `in`), `density` (kg/m³,
-//! default 7800), `crank_pin` and `piston_pin` (pin centres in file units; default the spec's
-//! mechanism, A at the origin and B 180 mm along x, expressed in the file's units), `pin_axis`
-//! (`"x"`, `"y"`, `"z"` (default) or a vector `[ax, ay, az]`). Unknown keys and wrong types are
-//! errors, so a typo never silently falls back to a default.
+//! default 7800), `crank_pin` and `piston_pin` (pin centres in file units), `pin_axis` (`"x"`,
+//! `"y"`, `"z"` or a vector `[ax, ay, az]`). Unknown keys and wrong types are errors, so a typo
+//! never silently falls back to a default.
+//!
+//! Pins: when the sidecar gives neither pin, both are left to the bore finder
+//! ([`super::bore_finder`], called by [`super::design::load_design`]), restricted to `pin_axis`
+//! if that is given. When it gives one pin, the other takes the spec's mechanism as before
+//! (A at the origin, B 180 mm along x from A, in the file's units) and the axis defaults to z.
 
 use anyhow::{Context, Result, bail};
 use nalgebra::Vector3;
@@ -72,8 +76,7 @@ pub struct Sidecar {
     pub density: Option<f64>,
     pub crank_pin: Option<[f64; 3]>,
     pub piston_pin: Option<[f64; 3]>,
-    #[serde(default)]
-    pub pin_axis: PinAxis,
+    pub pin_axis: Option<PinAxis>,
 }
 
 /// The sidecar with every default filled in and every value checked, in SI units.
@@ -82,9 +85,12 @@ pub struct DesignSettings {
     pub name: Option<String>,
     pub units: Units,
     pub density: f64,
-    pub crank_pin_m: Vector3<f64>,
-    pub piston_pin_m: Vector3<f64>,
-    pub pin_axis: Vector3<f64>,
+    /// The pin centres [m], both `Some` when the sidecar gives at least one of them (the other
+    /// then the spec's default), both `None` when they are to be found from the geometry.
+    pub crank_pin_m: Option<Vector3<f64>>,
+    pub piston_pin_m: Option<Vector3<f64>>,
+    /// The pin axis (unit) if the sidecar gives it.
+    pub pin_axis: Option<Vector3<f64>>,
     /// The sidecar file read, if there was one.
     pub source: Option<PathBuf>,
 }
@@ -119,6 +125,7 @@ impl Sidecar {
         if !(density.is_finite() && density > 0.0) {
             bail!("`density` must be a positive number of kg/m³, got {density}");
         }
+        let given = self.crank_pin.is_some() || self.piston_pin.is_some();
         let crank = Vector3::from(self.crank_pin.unwrap_or([0.0; 3]));
         let piston = match self.piston_pin {
             Some(p) => Vector3::from(p),
@@ -130,31 +137,48 @@ impl Sidecar {
             }
         }
         let axis = match &self.pin_axis {
-            PinAxis::Named(n) => match n.as_str() {
+            None => None,
+            Some(PinAxis::Named(n)) => Some(match n.as_str() {
                 "x" => Vector3::x(),
                 "y" => Vector3::y(),
                 "z" => Vector3::z(),
                 other => {
                     bail!("`pin_axis` must be \"x\", \"y\", \"z\" or [ax, ay, az], got {other:?}")
                 }
-            },
-            PinAxis::Vector(v) => {
+            }),
+            Some(PinAxis::Vector(v)) => {
                 let v = Vector3::from(*v);
                 if !(v.iter().all(|c| c.is_finite()) && v.norm() > 0.0) {
                     bail!("`pin_axis` must be a non-zero finite vector, got {v:?}");
                 }
-                v.normalize()
+                Some(v.normalize())
             }
         };
         Ok(DesignSettings {
             name: self.name,
             units: self.units,
             density,
-            crank_pin_m: crank * scale,
-            piston_pin_m: piston * scale,
+            crank_pin_m: given.then(|| crank * scale),
+            piston_pin_m: given.then(|| piston * scale),
             pin_axis: axis,
             source,
         })
+    }
+}
+
+impl DesignSettings {
+    /// The spec's mechanism in the file's units, used when the sidecar gives no pins and the
+    /// geometry has no cylindrical bore to find them from: A at the origin, B 180 mm along x,
+    /// the sidecar's axis or z (the same numbers as a sidecar giving one pin at the origin).
+    pub fn default_pins(&self) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+        let scale = self.units.to_metres();
+        let crank = Vector3::zeros();
+        let piston = crank + Vector3::x() * (DEFAULT_CENTRE_DISTANCE / scale);
+        (
+            crank * scale,
+            piston * scale,
+            self.pin_axis.unwrap_or_else(Vector3::z),
+        )
     }
 }
 
@@ -166,16 +190,26 @@ mod tests {
     fn defaults_are_the_spec_mechanism() {
         let s = Sidecar::default().resolve(None).unwrap();
         assert_eq!(s.density, 7800.0);
-        assert_eq!(s.crank_pin_m, Vector3::zeros());
-        assert!((s.piston_pin_m - Vector3::new(0.18, 0.0, 0.0)).norm() < 1e-15);
-        assert_eq!(s.pin_axis, Vector3::z());
+        assert_eq!(
+            (s.crank_pin_m, s.piston_pin_m, s.pin_axis),
+            (None, None, None)
+        );
+        let (a, b, axis) = s.default_pins();
+        assert_eq!(a, Vector3::zeros());
+        assert!((b - Vector3::new(0.18, 0.0, 0.0)).norm() < 1e-15);
+        assert_eq!(axis, Vector3::z());
+        // one pin given: the other from the spec's mechanism, axis z later
+        let one: Sidecar = toml::from_str("crank_pin = [0.0, 0.0, 0.0]").unwrap();
+        let one = one.resolve(None).unwrap();
+        assert_eq!(one.piston_pin_m, Some(b));
+        assert_eq!(one.pin_axis, None);
     }
 
     #[test]
     fn metres_keep_the_default_centre_distance() {
         let s: Sidecar = toml::from_str("units = \"m\"").unwrap();
         let s = s.resolve(None).unwrap();
-        assert!((s.piston_pin_m.x - 0.18).abs() < 1e-15);
+        assert!((s.default_pins().1.x - 0.18).abs() < 1e-15);
     }
 
     #[test]

@@ -4,8 +4,20 @@
 //! the triangles form a closed, edge-manifold, consistently and outward oriented surface. The
 //! checks, in the order reported: no degenerate triangles; every edge used by exactly two
 //! triangles (closed, manifold); each such edge traversed in opposite directions by its two
-//! triangles (consistent orientation); one connected shell; positive enclosed volume. A
-//! consistently inward-facing surface is flipped, with a warning; anything else is refused.
+//! triangles (consistent orientation); positive enclosed volume. A consistently inward-facing
+//! surface is flipped, with a warning; anything else is refused.
+//!
+//! Several bodies in one file (a rod and its cap exported together): the divergence theorem
+//! holds shell by shell, so the mass properties of disjoint closed shells simply add. Several
+//! closed, consistently oriented shells of the same orientation are accepted as one bonded
+//! body, with a warning; shells of opposite orientations (a body inside out, or a cavity whose
+//! meaning cannot be checked here) are refused as before. Bodies that touch along a face share
+//! its boundary edges, used by four (2k) triangles: such an edge is split into manifold edges
+//! by ordering its triangles around it (the radial-edge ordering of non-manifold solid
+//! modelling, Weiler 1986): each triangle bounds material on one side, the sequence must
+//! alternate between triangles that open and close a material wedge, and at least one of the
+//! empty wedges must have zero width (two coincident faces: a face contact). Two solids
+//! meeting along an edge only, or edges that do not alternate, stay non-manifold errors.
 
 use super::error::{Location, MeshError};
 use super::mass_properties::signed_volume_and_flagged;
@@ -35,11 +47,14 @@ pub fn validate(mut mesh: IndexedMesh) -> Result<ValidMesh, MeshError> {
         .min(mesh.vertices.len().div_ceil(4096))
         .max(1);
     let pairs = check_edges(&mesh, ranges)?;
-    check_one_shell(&mesh, &pairs)?;
+    let shells = shells(&mesh, &pairs);
     drop(pairs);
     let mut warnings = Vec::new();
     let (lo, hi) = mesh.bounding_box();
     let box_volume: f64 = (0..3).map(|k| hi[k] - lo[k]).product();
+    if let Some(roots) = shells {
+        warnings.push(check_shells(&mesh, &roots, box_volume)?);
+    }
     if volume.is_nan() || volume.abs() <= 1e-12 * box_volume {
         return Err(MeshError::ZeroVolume { volume });
     }
@@ -191,7 +206,14 @@ fn check_edges(mesh: &IndexedMesh, ranges: usize) -> Result<Vec<u32>, MeshError>
                                 *pairs.next().expect("a slot per use") = w as u32 & 0x7fff_ffff;
                             }
                         }
-                        ref more => found.non_manifold.push((key, more.len())),
+                        ref more => match pair_around_edge(mesh, low as u32, more) {
+                            Some(paired) => {
+                                for w in paired {
+                                    *pairs.next().expect("a slot per use") = w;
+                                }
+                            }
+                            None => found.non_manifold.push((key, more.len())),
+                        },
                     }
                 }
             }
@@ -230,10 +252,67 @@ fn check_edges(mesh: &IndexedMesh, ranges: usize) -> Result<Vec<u32>, MeshError>
     Ok(filed)
 }
 
+/// Largest width of an empty wedge between two coincident faces [rad] (see the module
+/// documentation): the faces of two bodies in contact, equal up to single-precision rounding.
+const CONTACT_ANGLE: f64 = 1e-4;
+
+/// The triangles around the edge from vertex `low` to the other vertex of `uses` (each use as
+/// filed by [`check_edges`]: other vertex, direction bit, triangle), in pairs bounding one
+/// material wedge each, or `None` unless they alternate with a zero-width empty wedge.
+fn pair_around_edge(mesh: &IndexedMesh, low: u32, uses: &[u64]) -> Option<Vec<u32>> {
+    if uses.len() % 2 == 1 {
+        return None;
+    }
+    let high = (uses[0] >> 32) as u32;
+    let p = mesh.vertices[low as usize];
+    let d = (mesh.vertices[high as usize] - p).normalize();
+    let e1 = d
+        .cross(&if d.x.abs() < 0.9 {
+            Vector3::x()
+        } else {
+            Vector3::y()
+        })
+        .normalize();
+    let e2 = d.cross(&e1);
+    // (angle of the third corner about the edge, closes a material wedge, triangle): a triangle
+    // traversing low → high has its outward normal towards increasing angle, so material lies
+    // just below its angle (it closes a wedge); one traversing high → low opens one.
+    let mut around: Vec<(f64, bool, u32)> = uses
+        .iter()
+        .map(|&w| {
+            let t = (w & 0x7fff_ffff) as u32;
+            let third = mesh.triangles[t as usize]
+                .into_iter()
+                .find(|&v| v != low && v != high)
+                .expect("a triangle has a third corner");
+            let r = mesh.vertices[third as usize] - p;
+            (r.dot(&e2).atan2(r.dot(&e1)), (w >> 31) & 1 == 1, t)
+        })
+        .collect();
+    // closers before openers at equal angles: coincident faces leave an empty wedge of width 0
+    around.sort_by(|a, b| a.0.total_cmp(&b.0).then(b.1.cmp(&a.1)).then(a.2.cmp(&b.2)));
+    let n = around.len();
+    let first = around.iter().position(|x| !x.1)?;
+    let mut paired = Vec::with_capacity(n);
+    let mut contact = false;
+    for k in (0..n).step_by(2) {
+        let (open, close) = (around[(first + k) % n], around[(first + k + 1) % n]);
+        if open.1 || !close.1 {
+            return None;
+        }
+        let next_open = around[(first + k + 2) % n];
+        let empty = (next_open.0 - close.0).rem_euclid(std::f64::consts::TAU);
+        contact |= empty <= CONTACT_ANGLE;
+        paired.extend([open.2, close.2]);
+    }
+    contact.then_some(paired)
+}
+
 /// Connected components of the triangles across shared edges (union–find with path halving);
 /// `pairs` holds two triangle numbers per edge. Each union makes the lower root the root, so
-/// every root is the lowest triangle of its shell, whatever the order of the pairs.
-fn check_one_shell(mesh: &IndexedMesh, pairs: &[u32]) -> Result<(), MeshError> {
+/// every root is the lowest triangle of its shell, whatever the order of the pairs. `None` for
+/// one shell, else each triangle's root.
+fn shells(mesh: &IndexedMesh, pairs: &[u32]) -> Option<Vec<u32>> {
     let mut parent: Vec<u32> = (0..mesh.triangles.len() as u32).collect();
     fn root(parent: &mut [u32], mut i: u32) -> u32 {
         while parent[i as usize] != i {
@@ -249,27 +328,52 @@ fn check_one_shell(mesh: &IndexedMesh, pairs: &[u32]) -> Result<(), MeshError> {
         }
     }
     if (0..parent.len() as u32).all(|i| root(&mut parent, i) == 0) {
-        return Ok(());
+        return None;
     }
-    let roots: Vec<u32> = (0..parent.len() as u32)
-        .map(|i| root(&mut parent, i))
-        .collect();
-    let first_root = roots[0];
-    let other: Vec<usize> = (0..roots.len())
-        .filter(|&t| roots[t] != first_root)
-        .collect();
-    let Some(&example) = other.first() else {
-        return Ok(());
-    };
-    let mut distinct = roots.clone();
+    Some(
+        (0..parent.len() as u32)
+            .map(|i| root(&mut parent, i))
+            .collect(),
+    )
+}
+
+/// Several shells: each must enclose volume, all with the orientation of most of the volume;
+/// returns the warning that says they are taken as one body.
+fn check_shells(mesh: &IndexedMesh, roots: &[u32], box_volume: f64) -> Result<String, MeshError> {
+    let (lo, hi) = mesh.bounding_box();
+    let reference = (lo + hi) / 2.0;
+    let mut distinct: Vec<u32> = roots.to_vec();
     distinct.sort_unstable();
     distinct.dedup();
-    let example_root = roots[example];
-    Err(MeshError::MultipleShells {
-        count: distinct.len(),
-        triangles: roots.iter().filter(|&&r| r == example_root).count(),
-        at: Location::from(mesh.vertices[mesh.triangles[example][0] as usize]),
-    })
+    let mut shell_volume = vec![0.0f64; distinct.len()];
+    let mut size = vec![0usize; distinct.len()];
+    for (t, r) in roots.iter().enumerate() {
+        let k = distinct.binary_search(r).expect("a root");
+        let [a, b, c] = mesh.corners(t).map(|p| p - reference);
+        shell_volume[k] += a.dot(&b.cross(&c)) / 6.0;
+        size[k] += 1;
+    }
+    // the orientation of most of the volume (outward on a tie) is the body's
+    let inward: f64 = shell_volume.iter().filter(|v| **v < 0.0).map(|v| -v).sum();
+    let outward: f64 = shell_volume.iter().filter(|v| **v > 0.0).sum();
+    let largest: f64 = if inward > outward { -1.0 } else { 1.0 };
+    for (k, &v) in shell_volume.iter().enumerate() {
+        if v.is_nan() || v.abs() <= 1e-12 * box_volume {
+            return Err(MeshError::ZeroVolume { volume: v });
+        }
+        if v.signum() != largest.signum() {
+            let t = distinct[k] as usize;
+            return Err(MeshError::MultipleShells {
+                count: distinct.len(),
+                triangles: size[k],
+                at: Location::from(mesh.vertices[mesh.triangles[t][0] as usize]),
+            });
+        }
+    }
+    Ok(format!(
+        "{} bodies (shells) in one file: treated as one bonded body (their mass properties add)",
+        distinct.len()
+    ))
 }
 
 #[cfg(test)]
@@ -349,14 +453,27 @@ mod tests {
     }
 
     #[test]
-    fn two_separate_solids_are_two_shells() {
+    fn two_separate_solids_are_one_body_with_a_warning() {
         let a = unit_box();
         let b = transformed(
             &unit_box(),
             &Matrix3::identity(),
             Vector3::new(5.0, 0.0, 0.0),
         );
-        let err = validate(union(&a, &b)).unwrap_err();
+        let v = validate(union(&a, &b)).unwrap();
+        assert_eq!(v.warnings.len(), 1);
+        assert!(
+            v.warnings[0].starts_with("2 bodies (shells) in one file"),
+            "{:?}",
+            v.warnings
+        );
+        assert!((signed_volume(&v.mesh) - 12.0).abs() < 1e-12);
+        // both inside out: flipped, both warnings
+        let v = validate(flipped(&union(&a, &b))).unwrap();
+        assert_eq!(v.warnings.len(), 2);
+        assert!(signed_volume(&v.mesh) > 0.0);
+        // one of them inside out: refused, the inverted shell located
+        let err = validate(union(&a, &flipped(&b))).unwrap_err();
         assert!(
             matches!(
                 err,
@@ -372,6 +489,24 @@ mod tests {
             err.to_string().contains("(5.5"),
             "location of the second shell: {err}"
         );
+    }
+
+    #[test]
+    fn bodies_touching_along_a_face_are_one_bonded_body() {
+        // a rod and its cap: two boxes sharing the face x = 0.5 (identical corners, so welded
+        // into edges of four triangles, and the shared face's two triangles back to back)
+        let a = cuboid(Vector3::repeat(1.0), Vector3::zeros());
+        let b = cuboid(Vector3::repeat(1.0), Vector3::new(1.0, 0.0, 0.0));
+        let m = crate::geometry::weld::weld(&crate::geometry::primitives::to_soup(&union(&a, &b)));
+        let v = validate(m).unwrap();
+        assert_eq!(v.warnings.len(), 1, "{:?}", v.warnings);
+        assert!(v.warnings[0].contains("treated as one bonded body"));
+        assert!((signed_volume(&v.mesh) - 2.0).abs() < 1e-12);
+        // a smaller second box on the face: the contact face is only part of a face
+        let c = cuboid(Vector3::new(1.0, 0.5, 0.5), Vector3::new(1.0, 0.0, 0.0));
+        let m = crate::geometry::weld::weld(&crate::geometry::primitives::to_soup(&union(&a, &c)));
+        let v = validate(m).unwrap();
+        assert!((signed_volume(&v.mesh) - 1.25).abs() < 1e-12);
     }
 
     #[test]
