@@ -39,7 +39,7 @@ Two commands, both ending with one line of JSON on standard output (progress goe
       element has a positive scaled Jacobian, otherwise it falls back to straight-sided elements
       (and says so in the JSON).
 
-  mesh_rod.py mesh-step STEP OUT_DIR --frame OX OY OZ XX XY XZ YX YY YZ ZX ZY ZZ --scale S
+  mesh_rod.py mesh-step STEP OUT_DIR --frame OX,OY,OZ,XX,XY,XZ,YX,YY,YZ,ZX,ZY,ZZ --scale S
                                      [--size 5] [--name NAME] [--size-field FILE]
       A STEP solid (the exact B-rep, through gmsh's OpenCASCADE kernel; several solids fused into one
       bonded body) -> curved 10-node tetrahedra whose midside nodes lie on the true surfaces
@@ -421,6 +421,8 @@ def cmd_mesh_step(args) -> dict:
     step = pathlib.Path(args.step)
     if not step.is_file():
         raise SystemExit(f"mesh_rod: no such STEP file: {step}")
+    if len(args.frame) != 12:
+        raise SystemExit(f"mesh_rod: --frame takes 12 numbers, got {len(args.frame)}")
     if not (args.size > 0 and math.isfinite(args.size)):
         raise SystemExit(f"mesh_rod: --size must be a positive number of mm, got {args.size}")
     out_dir = pathlib.Path(args.out_dir)
@@ -562,8 +564,9 @@ def main(argv=None) -> int:
     ps = sub.add_parser("mesh-step", help="STEP solid -> curved tet10 in the rod frame (.msh + .rodmesh)")
     ps.add_argument("step")
     ps.add_argument("out_dir")
-    ps.add_argument("--frame", type=float, nargs=12, required=True,
-                    help="origin (3) and the rod frame's x, y, z axes (3 each), file coordinates")
+    ps.add_argument("--frame", type=lambda v: [float(x) for x in v.split(",")], required=True,
+                    help="origin (3) and the rod frame's x, y, z axes (3 each), file coordinates, "
+                         "12 numbers separated by commas")
     ps.add_argument("--scale", type=float, required=True, help="millimetres per file unit")
     ps.add_argument("--size", type=float, default=5.0, help="target element size, mm (default 5)")
     ps.add_argument("--name", help="output base name (default: the STEP's stem)")

@@ -19,7 +19,9 @@ use super::bore_finder::{Bore, FoundPins, PinSearchError, find_bores, find_pins}
 use super::mass_properties::MassProperties;
 use super::mechanism_frame::{MechanismFrame, RodInFrame};
 use super::sidecar::DesignSettings;
+use super::step::{STEP_SCRIPT, StepReport, is_step, read_step};
 use super::stl_file::{StlFormat, read_stl_file};
+use crate::python_env::{pipeline_script, python};
 use super::validate::validate;
 use super::weld::{IndexedMesh, weld};
 use anyhow::{Context, Result, bail};
@@ -34,7 +36,7 @@ pub const PLAUSIBLE_MASS_KG: (f64, f64) = (0.01, 100.0);
 pub struct LoadedDesign {
     pub name: String,
     pub file: PathBuf,
-    pub format: StlFormat,
+    pub format: DesignFormat,
     pub settings: DesignSettings,
     /// Validated, outward-oriented surface in metres.
     pub mesh: IndexedMesh,
@@ -43,6 +45,35 @@ pub struct LoadedDesign {
     /// Where the pins came from and where they are.
     pub pins: Pins,
     pub warnings: Vec<String>,
+}
+
+/// The kind of design file.
+#[derive(Debug, Clone)]
+pub enum DesignFormat {
+    /// An STL (binary or ASCII): mass properties of the polyhedron.
+    Stl(StlFormat),
+    /// A STEP file read through gmsh's OpenCASCADE kernel: exact B-rep mass properties, and
+    /// stage 3 on the exact geometry ([`super::step`]).
+    Step(StepReport),
+}
+
+impl DesignFormat {
+    /// `binary`, `ascii` or `step`, as the record's `format` says.
+    pub fn name(&self) -> &'static str {
+        match self {
+            DesignFormat::Stl(StlFormat::Binary) => "binary",
+            DesignFormat::Stl(StlFormat::Ascii) => "ascii",
+            DesignFormat::Step(_) => "step",
+        }
+    }
+
+    /// The STEP reader's report, for a STEP design.
+    pub fn step(&self) -> Option<&StepReport> {
+        match self {
+            DesignFormat::Step(r) => Some(r),
+            DesignFormat::Stl(_) => None,
+        }
+    }
 }
 
 /// Where a design's pin centres came from.
@@ -162,12 +193,31 @@ fn design_name(stl: &Path, settings: &DesignSettings) -> String {
 pub fn load_design(stl: &Path) -> Result<LoadedDesign> {
     let settings = DesignSettings::for_stl(stl)?;
     let file = || stl.display().to_string();
-    let (soup, format) = read_stl_file(stl).with_context(file)?;
-    let valid = validate(weld(&soup)).with_context(file)?;
-    let mut warnings = valid.warnings;
     let scale = settings.units.to_metres();
+    let (soup, format, mut warnings) = if is_step(stl) {
+        // the exact solid through gmsh/OpenCASCADE, and a triangulation of it for the bore
+        // check, the frame and the stage-3 surface
+        let python = python().with_context(file)?;
+        let dir = tempfile::tempdir().with_context(file)?;
+        let surface = dir.path().join("surface.stl");
+        let report = read_step(&python, &pipeline_script(STEP_SCRIPT), stl, &surface)?;
+        let (soup, _) = read_stl_file(&surface).with_context(file)?;
+        let mut notes = Vec::new();
+        if report.solids_in_file > 1 {
+            notes.push(report.description());
+        }
+        (soup, DesignFormat::Step(report), notes)
+    } else {
+        let (soup, format) = read_stl_file(stl).with_context(file)?;
+        (soup, DesignFormat::Stl(format), Vec::new())
+    };
+    let valid = validate(weld(&soup)).with_context(file)?;
+    warnings.extend(valid.warnings);
     let mesh = valid.mesh.scaled(scale);
-    let mass = MassProperties::of_mesh(&mesh, settings.density);
+    let mass = match format.step() {
+        Some(report) => report.mass_properties(scale, settings.density),
+        None => MassProperties::of_mesh(&mesh, settings.density),
+    };
     let pins = place_pins(&settings, &mesh);
     let frame = MechanismFrame::new(pins.crank_m, pins.piston_m, pins.axis).with_context(file)?;
     let (lo, hi) = PLAUSIBLE_MASS_KG;
@@ -418,7 +468,7 @@ fn record(d: &LoadedDesign, stl: &Path, rod: Option<(RodInFrame, f64, f64)>) -> 
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default(),
         file: stl.display().to_string(),
-        format: format!("{:?}", d.format).to_lowercase(),
+        format: d.format.name().to_string(),
         triangles: d.mesh.triangles.len(),
         vertices: d.mesh.vertices.len(),
         units: d.settings.units.symbol().to_string(),
@@ -461,12 +511,21 @@ pub fn find_stl_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
                 .with_context(|| format!("{}: cannot list the folder", path.display()))?
                 .filter_map(|e| e.ok().map(|e| e.path()))
                 .filter(|p| {
-                    p.is_file() && p.extension().is_some_and(|e| e.eq_ignore_ascii_case("stl"))
+                    p.is_file()
+                        && (p.extension().is_some_and(|e| e.eq_ignore_ascii_case("stl"))
+                            || is_step(p))
                 })
                 .collect();
             found.sort();
+            // NAME.step beside NAME.stl: the exact geometry is the design, the STL is not a second one
+            let stems_with_step: std::collections::HashSet<PathBuf> = found
+                .iter()
+                .filter(|p| is_step(p))
+                .map(|p| p.with_extension(""))
+                .collect();
+            found.retain(|p| is_step(p) || !stems_with_step.contains(&p.with_extension("")));
             if found.is_empty() {
-                bail!("{}: no .stl files in this folder", path.display());
+                bail!("{}: no .stl files in this folder (nor .step/.stp)", path.display());
             }
             files.extend(found);
         } else if path.is_file() {

@@ -258,7 +258,7 @@ pub struct StepInRodFrame {
 
 /// Meshes the exact geometry of a STEP solid with curved 10-node tetrahedra (midside nodes on the
 /// true surfaces, made valid by gmsh's high-order optimiser) in the rod frame, millimetres, by
-/// running `python script mesh-step STEP OUT_DIR --frame … --scale S --size SIZE`, and reads the
+/// running `python script mesh-step STEP OUT_DIR --frame O,X,Y,Z --scale S --size SIZE`, and reads the
 /// resulting `OUT_DIR/<name>.rodmesh`. A mesh gmsh leaves with an inverted element is refused.
 pub fn mesh_step_with(
     python: &Path,
@@ -274,20 +274,21 @@ pub fn mesh_step_with(
         )));
     }
     std::fs::create_dir_all(out_dir).map_err(|e| FemError::io(out_dir, e))?;
-    let numbers: Vec<String> = step
+    let frame: String = step
         .origin
         .iter()
         .chain(step.axes.iter().flatten())
         .map(|v| format!("{v:?}"))
-        .collect();
+        .collect::<Vec<_>>()
+        .join(",");
     let (size, scale) = (format!("{size_mm}"), format!("{:?}", step.scale));
     let mut args: Vec<&std::ffi::OsStr> = vec![
         "mesh-step".as_ref(),
         step.step.as_os_str(),
         out_dir.as_os_str(),
         "--frame".as_ref(),
+        frame.as_ref(),
     ];
-    args.extend(numbers.iter().map(|n| std::ffi::OsStr::new(n.as_str())));
     let tail: [&std::ffi::OsStr; 4] = [
         "--scale".as_ref(),
         scale.as_ref(),

@@ -23,7 +23,7 @@ use crate::fem::facets::{FacetScale, reentrant_edges};
 use crate::fem::refinement::{RefinementStudy, refinement_study};
 use crate::fem::rod::{RodSolution, solve_rod_fields};
 use crate::fem::{BoreSpec, Material, RodOptions, TetMesh};
-use crate::mesher::{GmshRodMesher, MESHER_SCRIPT, MeshReport, convert_mesh};
+use crate::mesher::{GmshRodMesher, MESHER_SCRIPT, MeshReport, StepInRodFrame, convert_mesh};
 use crate::python_env::{pipeline_script, python};
 use anyhow::{Context, Result};
 use std::path::{Path, PathBuf};
@@ -109,6 +109,8 @@ pub fn fem(
 /// and the options of the rod analysis.
 struct Setup {
     surface: RodFrameSurface,
+    /// The exact geometry in the rod frame, for a STEP design.
+    step: Option<StepInRodFrame>,
     bores: BoreSpec,
     material: Material,
     singular_edges: Vec<[[f64; 3]; 2]>,
@@ -133,7 +135,18 @@ impl Setup {
             singular_band_m: Some(config.fem.singular_band_mm * 1e-3),
             ..RodOptions::default()
         };
+        let step = design.format.step().map(|_| {
+            let f = &design.frame;
+            let to_metres = design.settings.units.to_metres();
+            StepInRodFrame {
+                step: design.file.clone(),
+                origin: (f.origin / to_metres).into(),
+                axes: [f.x.into(), f.y.into(), f.z.into()],
+                scale: to_metres * 1e3,
+            }
+        });
         Setup {
+            step,
             bores: surface.bores(),
             surface,
             material: Material::from(&config.fem),
@@ -143,10 +156,11 @@ impl Setup {
         }
     }
 
-    /// The gmsh adapter on this surface (writes `work_dir/rod_frame.stl`).
+    /// The gmsh adapter on this surface (writes `work_dir/rod_frame.stl`), or on the exact
+    /// geometry of a STEP design (curved tet10).
     fn mesher(&self, work_dir: &Path) -> Result<GmshRodMesher> {
         let python = python().with_context(|| self.context.clone())?;
-        GmshRodMesher::new(
+        let mesher = GmshRodMesher::new(
             &python,
             &pipeline_script(MESHER_SCRIPT),
             &self.surface.stl_bytes,
@@ -154,7 +168,20 @@ impl Setup {
             work_dir,
             &self.context[..self.context.len() - ": FEM".len()],
         )
-        .with_context(|| self.context.clone())
+        .with_context(|| self.context.clone())?;
+        Ok(match &self.step {
+            Some(step) => mesher.with_step(step.clone()),
+            None => mesher,
+        })
+    }
+
+    /// What the meshes are made from, for `mesh.source`.
+    fn source(&self) -> &'static str {
+        if self.step.is_some() {
+            "gmsh from the STEP (curved tet10 on the exact geometry)"
+        } else {
+            "gmsh from the STL (straight-sided tet10)"
+        }
     }
 
     /// The record and the outcome of a solution on `mesh`.
@@ -213,7 +240,7 @@ pub fn fem_fixed(
     .with_context(|| setup.context.clone())?;
     let r: &MeshReport = &meshed.report;
     let summary = MeshSummary {
-        source: "gmsh from the STL (straight-sided tet10)".into(),
+        source: setup.source().into(),
         size_mm: Some(r.size_mm),
         elements: r.elements,
         nodes: r.nodes,
@@ -244,7 +271,16 @@ pub fn fem_adaptive(
         FEATURE_ANGLE_DEG,
         2.0,
     );
-    let floor = |p: [f64; 3]| facets.at(p.map(|v| v * 1e3)) * 1e-3;
+    // an STL's facets set a floor below which refinement resolves the facets, not the part; the
+    // exact geometry of a STEP has none
+    let exact = setup.step.is_some();
+    let floor = |p: [f64; 3]| {
+        if exact {
+            0.0
+        } else {
+            facets.at(p.map(|v| v * 1e3)) * 1e-3
+        }
+    };
     let c = settings;
     let opts = AdaptOptions {
         target_error_rel: c.target_error,
@@ -268,7 +304,7 @@ pub fn fem_adaptive(
     let r = mesher.last_report.expect("at least one mesh");
     let iterations = out.solution.result.fx.adaptive.len();
     let summary = MeshSummary {
-        source: "gmsh from the STL (straight-sided tet10), adaptive".into(),
+        source: format!("{}, adaptive", setup.source()),
         size_mm: None,
         elements: r.elements,
         nodes: r.nodes,
@@ -282,10 +318,18 @@ pub fn fem_adaptive(
             iterations,
             initial_size_mm: c.initial_size_mm,
             min_size_mm: c.min_size_mm,
-            floor: format!(
-                "the STL's local facet spacing on curved surfaces (kinks below {FEATURE_ANGLE_DEG}°), at least min_size_mm"
-            ),
-            facet_spacing_median_mm: facets.median_spacing(),
+            floor: if exact {
+                "none: the exact geometry (STEP); at least min_size_mm".into()
+            } else {
+                format!(
+                    "the STL's local facet spacing on curved surfaces (kinks below {FEATURE_ANGLE_DEG}°), at least min_size_mm"
+                )
+            },
+            facet_spacing_median_mm: if exact {
+                0.0
+            } else {
+                facets.median_spacing()
+            },
             monotone: out.monotone,
         }),
         surface_triangles: setup.surface_triangles(),
