@@ -211,9 +211,7 @@ fn peak_estimate(h: &PeakHistory, bound: f64, order: f64) -> (f64, bool, f64, f6
         // not refined at the peak, or not converging monotonically: no power law to extrapolate.
         // With three values the uncertainty is their spread (what refinement has been seen to
         // change); with two, the last change or the previous estimate, whichever is larger.
-        let e = if never_refined {
-            bound.max(d2.abs() / p2)
-        } else if k >= 2 {
+        let seen = if k >= 2 {
             let last3 = [v[k - 2].0, p1, p2];
             let (lo, hi) = last3
                 .iter()
@@ -222,7 +220,14 @@ fn peak_estimate(h: &PeakHistory, bound: f64, order: f64) -> (f64, bool, f64, f6
                 });
             (hi - lo) / p2
         } else {
-            (d2.abs() / p2).max(h.estimates.last().copied().unwrap_or(0.0))
+            d2.abs() / p2
+        };
+        let e = if never_refined {
+            bound.max(seen)
+        } else if k >= 2 {
+            seen
+        } else {
+            seen.max(h.estimates.last().copied().unwrap_or(0.0))
         };
         return (e, monotone, 0.0, p2);
     }
