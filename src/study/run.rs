@@ -168,23 +168,22 @@ fn study_one(
     if let (Some(cache), Some(key)) = (cache, &key)
         && let Some(hit) = cache.get::<CachedDesign>(&id, key)
         && files_present(&hit)
-    {
-        if let Ok(history) = stages::dynamics::history(
+        && let Ok(history) = stages::dynamics::history(
             &hit.mass,
             &scene,
             config.driven.gravity,
             &config.engine,
             Method::ClosedForm,
-        ) {
-            let result = DesignResult {
-                mass: hit.mass,
-                dynamics: hit.dynamics,
-                fem: hit.fem,
-                cycle: hit.cycle,
-                history,
-            };
-            return (Ok(result), true);
-        }
+        )
+    {
+        let result = DesignResult {
+            mass: hit.mass,
+            dynamics: hit.dynamics,
+            fem: hit.fem,
+            cycle: hit.cycle,
+            history,
+        };
+        return (Ok(result), true);
     }
     let mut failed = FailedDesign {
         file: stl.display().to_string(),
