@@ -403,3 +403,29 @@ fn the_default_prints_todays_fields() {
         "design,t_s,phi_rad,fa_x_n,fa_y_n,fa_abs_n,fb_x_n,fb_y_n,fb_abs_n,crank_torque_nm"
     );
 }
+
+/// Reference: the cache's rule (`src/study/cache.rs`): a changed setting or input reruns a design.
+/// The engine and the trace's bytes are in the key; the default engine leaves the key as before
+/// (the configuration serializes identically).
+#[test]
+fn the_cache_key_follows_the_engine_and_the_trace() {
+    use rodstudy::study::cache::design_key;
+    let stl = repo().join("designs/design1.stl");
+    let default = design_key(&stl, &StudyConfig::default()).unwrap();
+    let dir = tempdir("cache");
+    let trace = dir.join("t.csv");
+    write(&trace, "crank_angle_deg,pressure_bar\n0,10\n720,10\n");
+    let config_file = dir.join("e.toml");
+    write(&config_file, "[engine]\npressure_trace = \"t.csv\"\n");
+    let engine = StudyConfig::read(&config_file).unwrap();
+    let with_trace = design_key(&stl, &engine).unwrap();
+    assert_ne!(default, with_trace);
+    write(&trace, "crank_angle_deg,pressure_bar\n0,20\n720,20\n");
+    assert_ne!(design_key(&stl, &engine).unwrap(), with_trace);
+    let mut bore = engine;
+    bore.engine.cylinder_bore_mm = 90.0;
+    assert_ne!(
+        design_key(&stl, &bore).unwrap(),
+        design_key(&stl, &engine).unwrap()
+    );
+}
