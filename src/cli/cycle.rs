@@ -48,10 +48,11 @@ pub fn run(args: CycleArgs) -> Result<i32> {
     let mode = args.mesh.mode(&config)?;
     let design = stages::mass::load(&args.design)?;
     let mass = stages::mass::mass(&design)?;
-    let (dynamics, _) = stages::dynamics::dynamics(
+    let (dynamics, _) = stages::dynamics::dynamics_with(
         &mass,
         &config.driven_scene(),
         config.driven.gravity,
+        &config.engine,
         Method::ClosedForm,
     )?;
     let mut f = stages::fem::fem(

@@ -1,5 +1,6 @@
-//! `rodstudy dynamics driven DESIGN... [--json] [--csv FILE]` and `rodstudy dynamics table-5-1`
+//! `rodstudy dynamics driven DESIGN... [--config FILE] [--json] [--csv FILE]` and `rodstudy dynamics table-5-1`
 
+use crate::config::StudyConfig;
 use crate::free_run::{FreeRunOptions, Method as FreeMethod, run_free};
 use crate::geometry::design::find_stl_files;
 use crate::mechanism::{DrivenScene, MechanismParams, Method, table_5_1_check};
@@ -63,6 +64,12 @@ pub struct DrivenArgs {
     /// Number of output steps (intervals; default 5000).
     #[arg(long)]
     steps: Option<usize>,
+    /// Settings file (default: `rodstudy.toml` if present): its `[driven]` scene (which the
+    /// flags above override) and its `[engine]`. With `[engine] pressure_trace` the scene covers
+    /// the four-stroke cycle (720°, `--duration` is then replaced by 4π/ω) with the gas force,
+    /// and the CSV gains a `gas_force_n` column.
+    #[arg(long)]
+    config: Option<PathBuf>,
 }
 
 #[derive(Args)]
@@ -208,7 +215,9 @@ pub fn run(command: DynamicsCommand) -> Result<i32> {
 }
 
 fn driven(args: DrivenArgs) -> Result<i32> {
-    let defaults = DrivenScene::default();
+    let config = StudyConfig::load(args.config.as_deref())?;
+    let defaults = config.driven_scene();
+    let gravity = config.driven.gravity && !args.no_gravity;
     let scene = DrivenScene {
         omega_rad_s: args.omega.unwrap_or(defaults.omega_rad_s),
         duration_s: args.duration.unwrap_or(defaults.duration_s),
@@ -225,7 +234,9 @@ fn driven(args: DrivenArgs) -> Result<i32> {
         .map(|f| {
             stages::mass::load(f)
                 .and_then(|d| stages::mass::mass(&d))
-                .and_then(|m| stages::dynamics::dynamics(&m, &scene, !args.no_gravity, method))
+                .and_then(|m| {
+                    stages::dynamics::dynamics_with(&m, &scene, gravity, &config.engine, method)
+                })
         })
         .collect();
     let ok: Vec<&DesignDynamics> = outcomes

@@ -48,10 +48,11 @@ pub struct FemArgs {
 /// The design's peak pin force (stage 2), the load of both cases unless `--force` gives one.
 pub(crate) fn peak_force(design: &LoadedDesign, config: &StudyConfig) -> Result<f64> {
     let mass = stages::mass::mass(design)?;
-    let (dynamics, _) = stages::dynamics::dynamics(
+    let (dynamics, _) = stages::dynamics::dynamics_with(
         &mass,
         &config.driven_scene(),
         config.driven.gravity,
+        &config.engine,
         Method::ClosedForm,
     )?;
     Ok(dynamics.peak_pin_force_n)

@@ -26,7 +26,9 @@
 //! # Free-body equations, solved by hand
 //! Unknowns F_A (crank on rod at A), F_B (rod on piston at B), N (slide on
 //! piston), T (drive torque on the crank), F_O (ground on crank); g⃗ = (0, −g),
-//! F_p the applied piston force along +x.
+//! F_p the applied piston force along +x: the constant piston force minus the
+//! gas force F_gas(φ) = p(φ)·A (which pushes the piston towards the crank,
+//! [`GasForce`](super::gas::GasForce)), evaluated at the crank angle φ.
 //!
 //! * piston, x:  F_Bx + F_p + m₄ g_x = m₄ ẍ_B  ⇒ F_Bx = m₄ (ẍ_B − g_x) − F_p
 //! * rod, x:     F_Ax − F_Bx + m₃ g_x = m₃ a_G3,x  ⇒ F_Ax = m₃ (a_G3,x − g_x) + F_Bx
@@ -208,7 +210,11 @@ impl CrankSlider {
         let theta_ddot = cm.rod_angle[2];
         let pa = cm.a[0] - cm.g3[0];
         let pb = cm.b[0] - cm.g3[0];
-        let fbx = m4 * (k.xdd_b - g.x) - p.piston_force_n;
+        let mut fbx = m4 * (k.xdd_b - g.x) - p.piston_force_n;
+        if let Some(gas) = self.gas_force() {
+            // the gas pushes the piston along −x: F_p = piston_force − F_gas(φ)
+            fbx += gas.at(m.phi);
+        }
         let fax = m3 * (a_g3.x - g.x) + fbx;
         let s = m3 * (a_g3.y - g.y);
         let fby =

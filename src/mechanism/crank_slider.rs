@@ -20,14 +20,19 @@
 //!   eq. 2.27); its rotational inertia never enters (φ₄ ≡ 0).
 //!
 //! Loads: gravity g along −y (on by default, switchable) on all three bodies,
-//! and an optional constant piston force along global +x
-//! ([`MechanismParams::piston_force_n`], default 0; for the spec's `free` scene).
+//! an optional constant piston force along global +x
+//! ([`MechanismParams::piston_force_n`], default 0; for the spec's `free` scene),
+//! and an optional gas force F_gas(φ) = p(φ)·A_piston along global −x, a
+//! periodic function of the crank angle over the four-stroke cycle
+//! ([`CrankSlider::with_gas_force`], [`GasForce`]; none by default).
 
 use nalgebra::{SVector, Vector2};
 use serde::{Deserialize, Serialize};
+use std::sync::Arc;
 
 use super::body::BodyId;
 use super::error::{DynamicsError, Result, finite, non_negative, positive};
+use super::gas::GasForce;
 use super::linkage::CrankSliderLinkage;
 use super::motion::CrankMotion;
 use super::system::{
@@ -265,11 +270,13 @@ pub mod joints {
     pub const DRIVE: usize = 4;
 }
 
-/// A validated crank–slider: [`MechanismParams`] plus a [`RodInertia`].
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// A validated crank–slider: [`MechanismParams`] plus a [`RodInertia`], and
+/// optionally the gas force on the piston.
+#[derive(Clone, Debug, PartialEq)]
 pub struct CrankSlider {
     params: MechanismParams,
     rod: RodInertia,
+    gas: Option<Arc<GasForce>>,
 }
 
 impl CrankSlider {
@@ -281,7 +288,26 @@ impl CrankSlider {
         Ok(CrankSlider {
             params: *params,
             rod: *rod,
+            gas: None,
         })
+    }
+
+    /// The same mechanism with the gas force F_gas(φ) on the piston, directed
+    /// along global −x (towards the crank; see [`GasForce`]); both methods
+    /// evaluate it at the crank angle of each instant.
+    pub fn with_gas_force(mut self, gas: Option<Arc<GasForce>>) -> CrankSlider {
+        self.gas = gas;
+        self
+    }
+
+    /// The gas force, if any.
+    pub fn gas_force(&self) -> Option<&GasForce> {
+        self.gas.as_deref()
+    }
+
+    /// F_gas at crank angle φ (N, positive towards the crank); 0 without a gas force.
+    pub fn gas_force_at(&self, phi_rad: f64) -> f64 {
+        self.gas.as_ref().map_or(0.0, |g| g.at(phi_rad))
     }
 
     /// The mechanism parameters.
@@ -340,8 +366,8 @@ impl CrankSlider {
         b.build_with_dof::<9>()
     }
 
-    /// Bodies, joints O, A, B, slide ([`CrankSliderLinkage`]), gravity and the
-    /// piston force.
+    /// Bodies, joints O, A, B, slide ([`CrankSliderLinkage`]), gravity, the
+    /// piston force and the gas force (a function of the crank's angle φ₂).
     fn joints_and_loads(&self, options: SolverOptions) -> MultibodyBuilder {
         let p = &self.params;
         let linkage = CrankSliderLinkage {
@@ -366,6 +392,15 @@ impl CrankSlider {
                 body: CrankSliderLinkage::PISTON,
                 point: Vector2::zeros(),
                 force: Vector2::new(p.piston_force_n, 0.0),
+            });
+        }
+        if let Some(gas) = &self.gas {
+            b.add_load(AppliedLoad::GasForce {
+                body: CrankSliderLinkage::PISTON,
+                point: Vector2::zeros(),
+                direction: Vector2::new(-1.0, 0.0),
+                angle_of: CrankSliderLinkage::CRANK,
+                force: Arc::clone(gas),
             });
         }
         b

@@ -25,6 +25,7 @@
 //! | `forward.rs` | forward dynamics of such systems: the index-1 form [M −Dᵀ; D 0][c̈; λ] = [h; γ̃] (plain or Baumgarte), constraint violation, projection onto Φ = 0, D ċ = ν |
 //! | `linkage.rs` | [`CrankSliderLinkage`]: the crank–slider's bodies and joints O, A, B, slide on the core, written out once (for [`CrankSlider`] and the test rigs) |
 //! | `crank_slider.rs` | [`RodInertia`], [`MechanismParams`] (spec defaults, builder, validation), [`CrankSlider`] (validated model, its multibody form), [`PinLoads`] |
+//! | `gas.rs` | the cylinder pressure trace ([`PressureTrace`]: CSV, checks) and the gas force on the piston over 720° ([`GasForce`], periodic, linear between the rows) |
 //! | `closed_form.rs` | closed-form kinematics (eq. 2.1–2.12) and hand-solved Newton–Euler loads: the oracle |
 //! | `rod_cycle.rs` | [`rod_frame_cycle`]: one revolution in the rod frame (a_A, ω₃, α₃, g, pin forces from the rod's Newton–Euler) for the FEM stage |
 //! | `peak.rs` | the true maximum of \|F_A\| (scan + golden section on the closed form) |
@@ -62,6 +63,7 @@ pub mod crank_slider;
 pub mod driving;
 pub mod error;
 pub mod forward;
+pub mod gas;
 pub mod joint;
 pub mod linkage;
 pub mod motion;
@@ -83,11 +85,15 @@ pub use crank_slider::{
 };
 pub use error::{DynamicsError, Result};
 pub use forward::{Baumgarte, ConstraintViolation, ForwardSolution};
+pub use gas::{GasForce, PressureTrace, piston_area_m2};
 pub use linkage::{CrankSliderLinkage, LinkageJoint};
 pub use motion::{CrankMotion, MotionSample};
-pub use peak::{PeakRefinement, refine_peak, wrap_degrees};
+pub use peak::{PeakRefinement, refine_max_of, refine_peak, wrap_degrees, wrap_degrees_to};
 pub use rod_cycle::{RodFrameInstant, acceleration_of, rod_frame_cycle};
-pub use scene::{Agreement, DrivenResult, DrivenScene, Method, compare_results, driven_scene};
+pub use scene::{
+    Agreement, AxialPeaks, DrivenResult, DrivenScene, Method, compare_results, driven_scene,
+    driven_scene_with_gas,
+};
 pub use sensitivity::{PeakSensitivity, peak_sensitivity};
 pub use system::{
     AppliedLoad, GeneralizedForce, JointReaction, KinematicSolution, MultibodyBuilder,

@@ -23,7 +23,7 @@ pub struct PeakRefinement {
     pub force_n: f64,
     /// First time at which it occurs (s), in [0, min(duration, period)].
     pub time_s: f64,
-    /// Crank angle there, wrapped to [0, 360) degrees.
+    /// Crank angle there, wrapped to [0, 360) degrees ([0, 720) over the four-stroke cycle).
     pub crank_angle_deg: f64,
     /// Closed-form evaluations spent.
     pub evaluations: usize,
@@ -31,8 +31,13 @@ pub struct PeakRefinement {
 
 /// Angle in degrees wrapped to [0, 360).
 pub fn wrap_degrees(phi_rad: f64) -> f64 {
-    let d = phi_rad.to_degrees().rem_euclid(360.0);
-    if d >= 360.0 { 0.0 } else { d }
+    wrap_degrees_to(phi_rad, 360.0)
+}
+
+/// Angle in degrees wrapped to [0, period_deg) (720 for the four-stroke cycle).
+pub fn wrap_degrees_to(phi_rad: f64, period_deg: f64) -> f64 {
+    let d = phi_rad.to_degrees().rem_euclid(period_deg);
+    if d >= period_deg { 0.0 } else { d }
 }
 
 /// Golden-section search for the maximum of a unimodal `f` on [a, b]; stops
@@ -101,34 +106,55 @@ pub fn refine_peak(
 /// are narrow, so a model that tracks its solution from the previous time (the multibody core)
 /// can be used as it is.
 pub fn refine_peak_of(
-    mut f: impl FnMut(f64) -> f64,
+    f: impl FnMut(f64) -> f64,
     phi0_rad: f64,
     omega_rad_s: f64,
     duration_s: f64,
 ) -> Result<PeakRefinement> {
-    if !(omega_rad_s.is_finite() && omega_rad_s > 0.0 && duration_s.is_finite() && duration_s > 0.0)
+    refine_max_of(f, phi0_rad, omega_rad_s, duration_s, std::f64::consts::TAU)
+}
+
+/// [`refine_peak_of`] for a function of period `period_rad` of crank angle (2π for the
+/// inertia loads, 4π over the four-stroke cycle with a gas force): the scan has 360 points per
+/// revolution (1° apart), the reported angle is wrapped to [0, period) in degrees. `f` may be
+/// any quantity to maximise (|F_A|, the rod's axial compression, its tension).
+pub fn refine_max_of(
+    mut f: impl FnMut(f64) -> f64,
+    phi0_rad: f64,
+    omega_rad_s: f64,
+    duration_s: f64,
+    period_rad: f64,
+) -> Result<PeakRefinement> {
+    if !(omega_rad_s.is_finite()
+        && omega_rad_s > 0.0
+        && duration_s.is_finite()
+        && duration_s > 0.0
+        && period_rad.is_finite()
+        && period_rad > 0.0)
     {
         return Err(DynamicsError::InvalidScene(format!(
             "peak refinement needs omega > 0 and duration > 0 (got {omega_rad_s} rad/s, {duration_s} s)"
         )));
     }
-    let period = std::f64::consts::TAU / omega_rad_s;
+    let revolutions = (period_rad / std::f64::consts::TAU).round().max(1.0);
+    let scan = SCAN * revolutions as usize;
+    let period = period_rad / omega_rad_s;
     let periodic = duration_s >= period;
     let window = if periodic { period } else { duration_s };
-    let dt = window / SCAN as f64;
-    let mut v = [0.0f64; SCAN + 1];
+    let dt = window / scan as f64;
+    let mut v = vec![0.0f64; scan + 1];
     for (i, slot) in v.iter_mut().enumerate() {
         *slot = f(dt * i as f64);
     }
-    let mut evaluations = SCAN + 1;
+    let mut evaluations = scan + 1;
     // the best few local maxima (cyclic neighbours when periodic)
     let mut best: [(usize, f64); CANDIDATES] = [(usize::MAX, f64::NEG_INFINITY); CANDIDATES];
-    let last = if periodic { SCAN - 1 } else { SCAN };
+    let last = if periodic { scan - 1 } else { scan };
     for i in 0..=last {
         let prev = if i > 0 {
             v[i - 1]
         } else if periodic {
-            v[SCAN - 1]
+            v[scan - 1]
         } else {
             f64::NEG_INFINITY
         };
@@ -175,7 +201,7 @@ pub fn refine_peak_of(
     Ok(PeakRefinement {
         force_n: f_best,
         time_s: t_best,
-        crank_angle_deg: wrap_degrees(phi0_rad + omega_rad_s * t_best),
+        crank_angle_deg: wrap_degrees_to(phi0_rad + omega_rad_s * t_best, 360.0 * revolutions),
         evaluations,
     })
 }

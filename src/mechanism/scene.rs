@@ -16,13 +16,27 @@
 //! the maximum over the samples is reported next to it (`grid_peak_*`).
 //!
 //! Gravity is switched by [`MechanismParams::gravity`].
+//!
+//! # With a gas force (the engine, issue 20)
+//! [`driven_scene_with_gas`] adds the cylinder pressure's force on the piston
+//! ([`GasForce`], a function of the crank angle with period 720°). The scene
+//! then covers the four-stroke cycle ([`DrivenScene::four_stroke`]: φ from φ₀
+//! to φ₀ + 4π), peaks are searched over 720° and their crank angles wrapped to
+//! [0, 720). Besides |F_A|, the result carries the force along the rod axis
+//! at the crank pin, N_A = F_A · u with u the unit vector A→B (u = (cos ψ,
+//! −sin ψ), thesis eq. 2.3): N_A > 0 compresses the rod (the crank pushes it
+//! towards the piston), N_A < 0 pulls it; [`AxialPeaks`] holds the largest
+//! compression and tension (as magnitudes), each refined like the |F_A| peak,
+//! and the gas force at each.
 
 use serde::{Deserialize, Serialize};
+use std::sync::Arc;
 
 use super::crank_slider::{CrankSlider, MechanismParams, PinLoads, RodInertia};
 use super::error::{DynamicsError, Result};
+use super::gas::GasForce;
 use super::motion::CrankMotion;
-use super::peak::{refine_peak, refine_peak_of, wrap_degrees};
+use super::peak::{PeakRefinement, refine_max_of, refine_peak, refine_peak_of, wrap_degrees};
 
 /// Settings of the `driven` scene.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -98,6 +112,25 @@ impl DrivenScene {
     pub fn time(&self, k: usize) -> f64 {
         self.duration_s * (k as f64) / (self.steps as f64)
     }
+
+    /// The same crank speed over one four-stroke cycle: duration 4π/ω (φ from φ₀ to φ₀ + 4π),
+    /// with as many output steps per revolution as this scene has
+    /// (round(steps · (4π/ω) / duration), at least 2, so that φ₀ + 2π is a sample when this
+    /// scene's steps per revolution are whole; the default 5000 steps over 5 s at 40π rad/s
+    /// give 50 per revolution, 100 over the cycle, 7.2° apart).
+    pub fn four_stroke(&self) -> DrivenScene {
+        let duration_s = 2.0 * std::f64::consts::TAU / self.omega_rad_s;
+        let steps = (self.steps as f64 * duration_s / self.duration_s).round();
+        DrivenScene {
+            duration_s,
+            steps: if steps.is_finite() {
+                (steps as usize).clamp(2, MAX_STEPS)
+            } else {
+                2
+            },
+            ..*self
+        }
+    }
 }
 
 /// Which model solves the scene.
@@ -163,16 +196,43 @@ pub struct DrivenResult {
     /// True maximum of |F_A| over the motion (golden-section refinement on
     /// the closed form) (N).
     pub peak_pin_force_n: f64,
-    /// Crank angle of the true maximum, wrapped to [0, 360) degrees.
+    /// Crank angle of the true maximum, wrapped to [0, 360) degrees ([0, 720) with a gas
+    /// force).
     pub peak_crank_angle_deg: f64,
     /// First time of the true maximum (s).
     pub peak_time_s: f64,
     /// Maximum of |F_A| over the samples (N).
     pub grid_peak_pin_force_n: f64,
-    /// Crank angle of the sample maximum, wrapped to [0, 360) degrees.
+    /// Crank angle of the sample maximum, wrapped to [0, 360) degrees ([0, 720) with a gas
+    /// force).
     pub grid_peak_crank_angle_deg: f64,
     /// Time of the (first) sample maximum (s).
     pub grid_peak_time_s: f64,
+    /// Force along the rod axis at the crank pin, N_A = F_A · u (u the unit vector A→B;
+    /// positive = compression) (N).
+    pub rod_axial_n: Vec<f64>,
+    /// The largest compression and tension along the rod axis, refined.
+    pub axial: AxialPeaks,
+    /// The gas force on the piston F_gas(φ) = p(φ) A at each sample (N, positive towards the
+    /// crank); `None` without a gas force.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gas_force_n: Option<Vec<f64>>,
+}
+
+/// The extremes of the force along the rod axis over the scene (see the module
+/// documentation), each refined on the model that was asked for.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct AxialPeaks {
+    /// Largest compression max N_A (N, a magnitude; its angle in [0, 360), or [0, 720) with a
+    /// gas force). 0 if the rod is never compressed (the angle is then that of the least
+    /// tension).
+    pub compression: PeakRefinement,
+    /// Largest tension max(−N_A) (N, a magnitude); 0 if the rod is never in tension.
+    pub tension: PeakRefinement,
+    /// F_gas at the crank angle of the largest compression (N; 0 without a gas force).
+    pub compression_gas_force_n: f64,
+    /// F_gas at the crank angle of the largest tension (N; 0 without a gas force).
+    pub tension_gas_force_n: f64,
 }
 
 struct Series {
@@ -185,6 +245,8 @@ struct Series {
     fby: Vec<f64>,
     fb: Vec<f64>,
     torque: Vec<f64>,
+    axial: Vec<f64>,
+    gas: Vec<f64>,
 }
 
 impl Series {
@@ -199,11 +261,14 @@ impl Series {
             fby: Vec::with_capacity(n),
             fb: Vec::with_capacity(n),
             torque: Vec::with_capacity(n),
+            axial: Vec::with_capacity(n),
+            gas: Vec::with_capacity(n),
         }
     }
 
+    /// One sample: the loads, the rod's axial force N_A and the gas force.
     #[inline]
-    fn push(&mut self, t: f64, phi: f64, l: &PinLoads) -> Result<()> {
+    fn push(&mut self, t: f64, phi: f64, l: &PinLoads, axial: f64, gas: f64) -> Result<()> {
         let fa = l.f_a.norm();
         let fb = l.f_b.norm();
         if !(fa.is_finite() && fb.is_finite() && l.crank_torque_nm.is_finite()) {
@@ -221,60 +286,154 @@ impl Series {
         self.fby.push(l.f_b.y);
         self.fb.push(fb);
         self.torque.push(l.crank_torque_nm);
+        self.axial.push(axial);
+        self.gas.push(gas);
         Ok(())
     }
 }
 
-/// Run the `driven` scene for one rod with the chosen method.
+/// N_A = F_A · u, u = (cos θ₃, sin θ₃) the unit vector A→B for the rod angle θ₃ (= −ψ).
+fn axial_force(loads: &PinLoads, rod_angle_rad: f64) -> f64 {
+    let (s, c) = rod_angle_rad.sin_cos();
+    loads.f_a.x * c + loads.f_a.y * s
+}
+
+/// The closed form's loads and N_A at crank state m.
+fn closed_form_sample(model: &CrankSlider, m: super::motion::MotionSample) -> (PinLoads, f64) {
+    let loads = model.closed_form(m);
+    let k = model.closed_form_kinematics(m);
+    let axial = loads.f_a.x * k.cos_psi - loads.f_a.y * k.sin_psi;
+    (loads, axial)
+}
+
+/// Run the `driven` scene for one rod with the chosen method (no gas force).
 pub fn driven_scene(
     params: &MechanismParams,
     rod: &RodInertia,
     scene: &DrivenScene,
     method: Method,
 ) -> Result<DrivenResult> {
+    driven_scene_with_gas(params, rod, None, scene, method)
+}
+
+/// Run the `driven` scene with an optional gas force on the piston (see the module
+/// documentation). The scene is taken as given: pass [`DrivenScene::four_stroke`] to cover the
+/// cycle of a gas force. Peaks are searched over one period of the loads: 2π without a gas
+/// force, 4π with one.
+pub fn driven_scene_with_gas(
+    params: &MechanismParams,
+    rod: &RodInertia,
+    gas: Option<Arc<GasForce>>,
+    scene: &DrivenScene,
+    method: Method,
+) -> Result<DrivenResult> {
     scene.validate()?;
-    let model = CrankSlider::new(params, rod)?;
+    let model = CrankSlider::new(params, rod)?.with_gas_force(gas);
+    let with_gas = model.gas_force().is_some();
+    let period_rad = if with_gas {
+        2.0 * std::f64::consts::TAU
+    } else {
+        std::f64::consts::TAU
+    };
     let motion = scene.motion();
     let n = scene.samples();
     let mut s = Series::with_capacity(n);
-    // the peak is refined on the model that was asked for
-    let peak = match method {
+    let (phi0, omega, duration) = (scene.phi0_rad, scene.omega_rad_s, scene.duration_s);
+    // the peaks are refined on the model that was asked for
+    let (peak, compression, tension) = match method {
         Method::ClosedForm => {
             for k in 0..n {
                 let t = scene.time(k);
                 let m = motion.sample(t);
-                s.push(t, m.phi, &model.closed_form(m))?;
+                let (loads, axial) = closed_form_sample(&model, m);
+                s.push(t, m.phi, &loads, axial, model.gas_force_at(m.phi))?;
             }
-            refine_peak(&model, scene.phi0_rad, scene.omega_rad_s, scene.duration_s)?
+            let peak = if with_gas {
+                refine_max_of(
+                    |t| model.closed_form(motion.sample(t)).f_a.norm(),
+                    phi0,
+                    omega,
+                    duration,
+                    period_rad,
+                )?
+            } else {
+                refine_peak(&model, phi0, omega, duration)?
+            };
+            let axial = |t: f64| closed_form_sample(&model, motion.sample(t)).1;
+            let compression = refine_max_of(axial, phi0, omega, duration, period_rad)?;
+            let tension = refine_max_of(|t| -axial(t), phi0, omega, duration, period_rad)?;
+            (peak, compression, tension)
         }
         Method::Multibody => {
             let sys = model.multibody(motion)?;
-            let mut tracker = sys.tracker(model.assembly_guess(scene.phi0_rad));
+            let mut tracker = sys.tracker(model.assembly_guess(phi0));
             for k in 0..n {
                 let t = scene.time(k);
                 let sol = tracker.solve_at(t)?;
                 let loads = model.loads_from_multibody(&sys, sol);
-                s.push(t, sol.q[2], &loads)?;
+                // q = (crank x, y, φ₂, rod x, y, θ₃, piston x, y, φ₄)
+                let axial = axial_force(&loads, sol.q[5]);
+                s.push(t, sol.q[2], &loads, axial, model.gas_force_at(sol.q[2]))?;
             }
-            let mut tracker = sys.tracker(model.assembly_guess(scene.phi0_rad));
-            let mut failure = None;
-            let peak = refine_peak_of(
-                |t| match tracker.solve_at(t) {
-                    Ok(sol) => model.loads_from_multibody(&sys, sol).f_a.norm(),
-                    Err(e) => {
-                        failure.get_or_insert(e);
-                        f64::NAN
-                    }
-                },
-                scene.phi0_rad,
-                scene.omega_rad_s,
-                scene.duration_s,
-            );
-            if let Some(e) = failure {
-                return Err(e);
-            }
-            peak?
+            // a quantity of the multibody solution at time t, each search with its own tracker
+            let refine = |quantity: &dyn Fn(&PinLoads, f64) -> f64| {
+                let mut tracker = sys.tracker(model.assembly_guess(phi0));
+                let mut failure = None;
+                let peak = refine_max_of(
+                    |t| match tracker.solve_at(t) {
+                        Ok(sol) => quantity(&model.loads_from_multibody(&sys, sol), sol.q[5]),
+                        Err(e) => {
+                            failure.get_or_insert(e);
+                            f64::NAN
+                        }
+                    },
+                    phi0,
+                    omega,
+                    duration,
+                    period_rad,
+                );
+                match failure {
+                    Some(e) => Err(e),
+                    None => peak,
+                }
+            };
+            let peak = if with_gas {
+                refine(&|l, _| l.f_a.norm())?
+            } else {
+                let mut tracker = sys.tracker(model.assembly_guess(phi0));
+                let mut failure = None;
+                let peak = refine_peak_of(
+                    |t| match tracker.solve_at(t) {
+                        Ok(sol) => model.loads_from_multibody(&sys, sol).f_a.norm(),
+                        Err(e) => {
+                            failure.get_or_insert(e);
+                            f64::NAN
+                        }
+                    },
+                    phi0,
+                    omega,
+                    duration,
+                );
+                if let Some(e) = failure {
+                    return Err(e);
+                }
+                peak?
+            };
+            let compression = refine(&axial_force)?;
+            let tension = refine(&|l, theta| -axial_force(l, theta))?;
+            (peak, compression, tension)
         }
+    };
+    let gas_at = |p: &PeakRefinement| model.gas_force_at(phi0 + omega * p.time_s);
+    let magnitude = |mut p: PeakRefinement| {
+        p.force_n = p.force_n.max(0.0);
+        p
+    };
+    let axial = AxialPeaks {
+        compression_gas_force_n: gas_at(&compression),
+        tension_gas_force_n: gas_at(&tension),
+        compression: magnitude(compression),
+        tension: magnitude(tension),
     };
     let mut grid = 0usize;
     for (k, v) in s.fa.iter().enumerate() {
@@ -282,6 +441,11 @@ pub fn driven_scene(
             grid = k;
         }
     }
+    let grid_angle = if with_gas {
+        super::peak::wrap_degrees_to(s.phi[grid], 720.0)
+    } else {
+        wrap_degrees(s.phi[grid])
+    };
     Ok(DrivenResult {
         method,
         model: method.description(),
@@ -293,7 +457,7 @@ pub fn driven_scene(
         peak_crank_angle_deg: peak.crank_angle_deg,
         peak_time_s: peak.time_s,
         grid_peak_pin_force_n: s.fa[grid],
-        grid_peak_crank_angle_deg: wrap_degrees(s.phi[grid]),
+        grid_peak_crank_angle_deg: grid_angle,
         grid_peak_time_s: s.t[grid],
         t_s: s.t,
         phi_rad: s.phi,
@@ -304,6 +468,9 @@ pub fn driven_scene(
         fb_y_n: s.fby,
         fb_abs_n: s.fb,
         crank_torque_nm: s.torque,
+        rod_axial_n: s.axial,
+        axial,
+        gas_force_n: with_gas.then_some(s.gas),
     })
 }
 

@@ -145,13 +145,16 @@ pub fn pin_force_csv(design: &str, run: &DrivenResult) -> Result<Vec<u8>> {
 }
 
 /// The pin-force history as CSV rows (with a `design` column, so several designs share a file).
+/// With a gas force (an `[engine] pressure_trace`) the rows gain a last column `gas_force_n`, the
+/// force p·A on the piston [N, positive towards the crank]; without one the columns are exactly
+/// those of the thesis' rig, so default files stay byte-identical.
 pub fn write_history_csv<W: std::io::Write>(
     w: &mut csv::Writer<W>,
     design: &str,
     run: &DrivenResult,
 ) -> Result<()> {
     for k in 0..run.t_s.len() {
-        w.serialize(HistoryRow {
+        let row = HistoryRow {
             design,
             t_s: run.t_s[k],
             phi_rad: run.phi_rad[k],
@@ -162,7 +165,23 @@ pub fn write_history_csv<W: std::io::Write>(
             fb_y_n: run.fb_y_n[k],
             fb_abs_n: run.fb_abs_n[k],
             crank_torque_nm: run.crank_torque_nm[k],
-        })?;
+        };
+        match &run.gas_force_n {
+            None => w.serialize(row)?,
+            Some(gas) => w.serialize(HistoryRowGas {
+                design: row.design,
+                t_s: row.t_s,
+                phi_rad: row.phi_rad,
+                fa_x_n: row.fa_x_n,
+                fa_y_n: row.fa_y_n,
+                fa_abs_n: row.fa_abs_n,
+                fb_x_n: row.fb_x_n,
+                fb_y_n: row.fb_y_n,
+                fb_abs_n: row.fb_abs_n,
+                crank_torque_nm: row.crank_torque_nm,
+                gas_force_n: gas[k],
+            })?,
+        }
     }
     Ok(())
 }
@@ -179,4 +198,20 @@ struct HistoryRow<'a> {
     fb_y_n: f64,
     fb_abs_n: f64,
     crank_torque_nm: f64,
+}
+
+/// [`HistoryRow`] with the gas force.
+#[derive(Serialize)]
+struct HistoryRowGas<'a> {
+    design: &'a str,
+    t_s: f64,
+    phi_rad: f64,
+    fa_x_n: f64,
+    fa_y_n: f64,
+    fa_abs_n: f64,
+    fb_x_n: f64,
+    fb_y_n: f64,
+    fb_abs_n: f64,
+    crank_torque_nm: f64,
+    gas_force_n: f64,
 }

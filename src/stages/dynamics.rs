@@ -6,9 +6,10 @@
 //! (model only what the scene needs).
 
 use super::records::{DesignDynamics, DesignMass};
+use crate::config::EngineConfig;
 use crate::mechanism::{
-    DrivenResult, DrivenScene, MechanismParams, Method, RodInertia, driven_scene, peak_sensitivity,
-    tdc_peak_formula,
+    DrivenResult, DrivenScene, GasForce, MechanismParams, Method, RodInertia,
+    driven_scene_with_gas, peak_sensitivity, tdc_peak_formula,
 };
 use anyhow::{Context, Result};
 
@@ -17,7 +18,8 @@ pub fn rod_inertia(mass: &DesignMass) -> RodInertia {
     RodInertia::new(mass.mass_kg, mass.l1_m, mass.i_zz_kgm2).with_offset(mass.offset_m)
 }
 
-/// The spec's mechanism with this design's centre distance.
+/// The spec's mechanism (the thesis' rig, the default engine) with this design's centre
+/// distance.
 pub fn mechanism_for(mass: &DesignMass, gravity: bool) -> MechanismParams {
     MechanismParams {
         centre_distance_m: mass.centre_distance_m,
@@ -26,18 +28,79 @@ pub fn mechanism_for(mass: &DesignMass, gravity: bool) -> MechanismParams {
     .with_gravity(gravity)
 }
 
-/// Runs the `driven` scene for a design and summarises it; returns the full history too.
+/// The configured engine's mechanism with this design's centre distance (equal to
+/// [`mechanism_for`] for the default engine).
+pub fn engine_mechanism_for(
+    mass: &DesignMass,
+    engine: &EngineConfig,
+    gravity: bool,
+) -> MechanismParams {
+    engine.mechanism(mass.centre_distance_m, gravity)
+}
+
+/// The scene stage 2 runs: `scene` as configured, or with a gas force its four-stroke cycle
+/// ([`DrivenScene::four_stroke`]: 720° at the same speed and output steps per revolution).
+pub fn scene_for(scene: &DrivenScene, gas: Option<&GasForce>) -> DrivenScene {
+    match gas {
+        Some(_) => scene.four_stroke(),
+        None => *scene,
+    }
+}
+
+/// The pin-force history alone (e.g. for a design whose figures come from the cache).
+pub fn history(
+    mass: &DesignMass,
+    scene: &DrivenScene,
+    gravity: bool,
+    engine: &EngineConfig,
+    method: Method,
+) -> Result<DrivenResult> {
+    let gas = engine.gas_force()?;
+    let params = engine_mechanism_for(mass, engine, gravity);
+    let scene = scene_for(scene, gas.as_deref());
+    Ok(driven_scene_with_gas(
+        &params,
+        &rod_inertia(mass),
+        gas,
+        &scene,
+        method,
+    )?)
+}
+
+/// Runs the `driven` scene for a design on the thesis' rig (the default engine, no gas force)
+/// and summarises it; returns the full history too.
 pub fn dynamics(
     mass: &DesignMass,
     scene: &DrivenScene,
     gravity: bool,
     method: Method,
 ) -> Result<(DesignDynamics, DrivenResult)> {
+    dynamics_with(mass, scene, gravity, &EngineConfig::default(), method)
+}
+
+/// [`dynamics`] on the configured engine.
+///
+/// With a pressure trace in `engine`, the scene covers the four-stroke cycle with the gas force
+/// and the summary gains the rod's peak compression and tension (`peak_compression_n`, …);
+/// `tdc_formula_n` and `sensitivity` stay those of the inertia loads alone (constant speed, no
+/// gas force), as without a trace.
+pub fn dynamics_with(
+    mass: &DesignMass,
+    scene: &DrivenScene,
+    gravity: bool,
+    engine: &EngineConfig,
+    method: Method,
+) -> Result<(DesignDynamics, DrivenResult)> {
     let context = || format!("{}: dynamics", mass.file);
-    let params = mechanism_for(mass, gravity);
+    let gas = engine.gas_force().with_context(context)?;
+    let with_gas = gas.is_some();
+    let params = engine_mechanism_for(mass, engine, gravity);
     let rod = rod_inertia(mass);
-    let run = driven_scene(&params, &rod, scene, method).with_context(context)?;
+    let scene = scene_for(scene, gas.as_deref());
+    let run = driven_scene_with_gas(&params, &rod, gas, &scene, method).with_context(context)?;
     let sensitivity = peak_sensitivity(&params, &rod, scene.omega_rad_s).with_context(context)?;
+    let axial = run.axial;
+    let engine_field = |v: f64| with_gas.then_some(v);
     let summary = DesignDynamics {
         design: mass.design.clone(),
         peak_pin_force_n: run.peak_pin_force_n,
@@ -52,6 +115,12 @@ pub fn dynamics(
         steps: scene.steps,
         tdc_formula_n: tdc_peak_formula(&params, &rod, scene.omega_rad_s),
         sensitivity,
+        peak_compression_n: engine_field(axial.compression.force_n),
+        peak_compression_crank_angle_deg: engine_field(axial.compression.crank_angle_deg),
+        peak_compression_gas_force_n: engine_field(axial.compression_gas_force_n),
+        peak_tension_n: engine_field(axial.tension.force_n),
+        peak_tension_crank_angle_deg: engine_field(axial.tension.crank_angle_deg),
+        peak_tension_gas_force_n: engine_field(axial.tension_gas_force_n),
     };
     Ok((summary, run))
 }

@@ -37,6 +37,26 @@ pub struct DesignDynamics {
     pub tdc_formula_n: f64,
     /// ∂F/∂m3, ∂F/∂l1, ∂F/∂I_zz of the peak at constant speed.
     pub sensitivity: PeakSensitivity,
+    /// With a pressure trace (`[engine] pressure_trace`) only: the largest compression along
+    /// the rod axis A→B at the crank pin, max (F_A · u) over the four-stroke cycle [N, magnitude].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_compression_n: Option<f64>,
+    /// Its crank angle in [0, 720) degrees (0 = firing top dead centre).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_compression_crank_angle_deg: Option<f64>,
+    /// The gas force p·A on the piston there [N].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_compression_gas_force_n: Option<f64>,
+    /// With a pressure trace only: the largest tension along the rod axis, max (−F_A · u)
+    /// [N, magnitude].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_tension_n: Option<f64>,
+    /// Its crank angle in [0, 720) degrees.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_tension_crank_angle_deg: Option<f64>,
+    /// The gas force p·A on the piston there [N].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_tension_gas_force_n: Option<f64>,
 }
 
 /// How the mesh was made.

@@ -2,8 +2,8 @@
 //! figures; changing a design's STL or sidecar, the configuration or the program reruns only
 //! the designs concerned.
 //!
-//! The key is the SHA-256 of the program version, the configuration (as JSON), the STL bytes and
-//! the sidecar bytes. Entries live in `OUT/.cache/<id>.json`, written atomically.
+//! The key is the SHA-256 of the program version, the configuration (as JSON), the bytes of its
+//! pressure trace if it has one, the STL bytes and the sidecar bytes. Entries live in `OUT/.cache/<id>.json`, written atomically.
 
 use crate::config::StudyConfig;
 use crate::report::atomic_write::write_atomic;
@@ -17,6 +17,12 @@ pub fn design_key(stl: &Path, config: &StudyConfig) -> Result<String> {
     let mut h = Sha256::new();
     h.update(env!("CARGO_PKG_VERSION").as_bytes());
     h.update(serde_json::to_vec(config)?);
+    // the configuration names the pressure trace; its content counts too (nothing is added
+    // without a trace, so the default study's keys stay as they were)
+    if let Some(trace) = config.engine.pressure_trace {
+        h.update(b"pressure_trace");
+        h.update(std::fs::read(trace.as_path())?);
+    }
     h.update(std::fs::read(stl)?);
     let sidecar = crate::geometry::sidecar::sidecar_path(stl);
     if let Ok(bytes) = std::fs::read(&sidecar) {

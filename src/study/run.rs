@@ -168,21 +168,22 @@ fn study_one(
     if let (Some(cache), Some(key)) = (cache, &key)
         && let Some(hit) = cache.get::<CachedDesign>(&id, key)
         && files_present(&hit)
+        && let Ok(history) = stages::dynamics::history(
+            &hit.mass,
+            &scene,
+            config.driven.gravity,
+            &config.engine,
+            Method::ClosedForm,
+        )
     {
-        let params = stages::dynamics::mechanism_for(&hit.mass, config.driven.gravity);
-        let rod = stages::dynamics::rod_inertia(&hit.mass);
-        if let Ok(history) =
-            crate::mechanism::driven_scene(&params, &rod, &scene, Method::ClosedForm)
-        {
-            let result = DesignResult {
-                mass: hit.mass,
-                dynamics: hit.dynamics,
-                fem: hit.fem,
-                cycle: hit.cycle,
-                history,
-            };
-            return (Ok(result), true);
-        }
+        let result = DesignResult {
+            mass: hit.mass,
+            dynamics: hit.dynamics,
+            fem: hit.fem,
+            cycle: hit.cycle,
+            history,
+        };
+        return (Ok(result), true);
     }
     let mut failed = FailedDesign {
         file: stl.display().to_string(),
@@ -194,8 +195,13 @@ fn study_one(
         let mass = stages::mass::mass(&design)?;
         failed.mass = Some(mass.clone());
         failed.stage = STAGES[1].into();
-        let (dynamics, history) =
-            stages::dynamics::dynamics(&mass, &scene, config.driven.gravity, Method::ClosedForm)?;
+        let (dynamics, history) = stages::dynamics::dynamics_with(
+            &mass,
+            &scene,
+            config.driven.gravity,
+            &config.engine,
+            Method::ClosedForm,
+        )?;
         failed.dynamics = Some(dynamics.clone());
         failed.history = Some(history.clone());
         failed.stage = STAGES[2].into();

@@ -117,8 +117,8 @@ where
             h[3 * k + 1] = b.mass_kg * self.gravity.y;
         }
         for load in &self.loads {
-            match *load {
-                AppliedLoad::Force {
+            match load {
+                &AppliedLoad::Force {
                     body: BodyId::Moving(k),
                     point,
                     force,
@@ -127,10 +127,23 @@ where
                     h[3 * k + 1] += force.y;
                     h[3 * k + 2] += cross(p[k].rotate(point), force);
                 }
-                AppliedLoad::Torque {
+                &AppliedLoad::Torque {
                     body: BodyId::Moving(k),
                     torque_nm,
                 } => h[3 * k + 2] += torque_nm,
+                AppliedLoad::GasForce {
+                    body: BodyId::Moving(k),
+                    point,
+                    direction,
+                    angle_of,
+                    force,
+                } => {
+                    let k = *k;
+                    let f = direction * force.at(pose_of(p, *angle_of).phi);
+                    h[3 * k] += f.x;
+                    h[3 * k + 1] += f.y;
+                    h[3 * k + 2] += cross(p[k].rotate(*point), f);
+                }
                 _ => {}
             }
         }

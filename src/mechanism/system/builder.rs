@@ -255,11 +255,26 @@ impl MultibodyBuilder {
             });
         }
         for load in &self.loads {
-            let (body, ok) = match *load {
-                AppliedLoad::Force { body, point, force } => {
+            let (body, ok) = match load {
+                &AppliedLoad::Force { body, point, force } => {
                     (body, vec_finite(point) && vec_finite(force))
                 }
-                AppliedLoad::Torque { body, torque_nm } => (body, torque_nm.is_finite()),
+                &AppliedLoad::Torque { body, torque_nm } => (body, torque_nm.is_finite()),
+                AppliedLoad::GasForce {
+                    body,
+                    point,
+                    direction,
+                    angle_of,
+                    ..
+                } => (
+                    *body,
+                    vec_finite(*point)
+                        && vec_finite(*direction)
+                        && match *angle_of {
+                            BodyId::Ground => true,
+                            BodyId::Moving(j) => j < nb,
+                        },
+                ),
             };
             match body {
                 BodyId::Moving(k) if k < nb && ok => {}

@@ -73,6 +73,7 @@ mod tests;
 use nalgebra::{Const, DimMin, SVector, Vector2};
 
 use super::body::{Body, BodyId, Pose, Twist};
+use super::gas::GasForce;
 use super::joint::Joint;
 
 pub use analysis::{KinematicSolution, RANK_CONFIRM};
@@ -111,7 +112,7 @@ impl Default for SolverOptions {
 }
 
 /// A load applied to a moving body (goes into h, thesis eq. 3.31).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum AppliedLoad {
     /// Constant force (global frame, N) acting at a body-fixed point (body frame, m).
     Force {
@@ -128,6 +129,21 @@ pub enum AppliedLoad {
         body: BodyId,
         /// Torque about the plane normal.
         torque_nm: f64,
+    },
+    /// A force of fixed global direction whose magnitude is a periodic function of another
+    /// body's angle: F = direction · F_gas(φ_angle_of) at a body-fixed point — the cylinder
+    /// pressure on the piston as a function of the crank angle ([`GasForce`]).
+    GasForce {
+        /// Loaded body.
+        body: BodyId,
+        /// Point of application s'ᴾ in the body frame.
+        point: Vector2<f64>,
+        /// Direction of a positive magnitude (global frame, unit vector).
+        direction: Vector2<f64>,
+        /// The body whose angle φ is the argument (the crank).
+        angle_of: BodyId,
+        /// The magnitude F_gas(φ) (N).
+        force: std::sync::Arc<GasForce>,
     },
 }
 
