@@ -302,11 +302,22 @@ pub fn fem_user_mesh(
     work_dir: &Path,
     file: &Path,
 ) -> Result<FemOutcome> {
-    let setup = Setup::new(design, config);
+    // the mesh is read (gmsh MSH 4.1 and .inp natively, other formats through meshio, into
+    // work_dir/user.rodmesh) while the rod-frame surface and its singular edges are prepared
+    let (setup, read) = std::thread::scope(|scope| {
+        let reading = scope.spawn(|| {
+            let start = std::time::Instant::now();
+            read_volume_mesh(file, "mm", work_dir).map(|(m, _)| (m, start.elapsed()))
+        });
+        let setup = Setup::new(design, config);
+        let read = reading
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        (setup, read)
+    });
+    let (read, read_time) =
+        read.with_context(|| format!("{}: cannot use this volume mesh", file.display()))?;
     let start = std::time::Instant::now();
-    // gmsh MSH 4.1 and .inp natively, other formats through meshio (work_dir/user.rodmesh)
-    let (read, _reader) = read_volume_mesh(file, "mm", work_dir)
-        .with_context(|| format!("{}: cannot use this volume mesh", file.display()))?;
     // the file's numbers were read as mm (×1e-3); the file is in the design's units
     let f = setup.surface.frame;
     let s = setup.surface.to_metres * 1e3;
@@ -317,7 +328,7 @@ pub fn fem_user_mesh(
         })
         .with_context(|| format!("{}: the mesh in the rod frame", file.display()))?;
     // reading and moving the mesh, not the analysis (fem.total_s)
-    let mesh_seconds = start.elapsed().as_secs_f64();
+    let mesh_seconds = (read_time + start.elapsed()).as_secs_f64();
     let solution = solve_rod_fields(&mesh, &setup.material, &setup.bores, force_n, &setup.rod)
         .with_context(|| setup.context.clone())?;
     let summary = MeshSummary {
