@@ -66,8 +66,8 @@ pub struct CcxRun {
     pub max_von_mises_averaged_mpa: [f64; 2],
     /// Ours on the same mesh (the run above), MPa.
     pub ours_max_von_mises_averaged_mpa: [f64; 2],
-    /// The whole `fem --mesh` run (default flags) / ccx's wall time.
-    pub ratio_fem_run_to_ccx: f64,
+    /// Each whole `fem --mesh` run of [`MeshPathBench::runs`] / ccx's wall time.
+    pub ratio_fem_runs_to_ccx: Vec<f64>,
 }
 
 /// What [`bench_fem_mesh`] measures.
@@ -92,6 +92,18 @@ pub struct MeshPathBench {
     /// `fem --mesh` as a command, with and without pictures.
     pub runs: Vec<WholeRun>,
     pub ccx: Option<CcxRun>,
+    /// The 1-minute load average (/proc/loadavg) before and after, when available: other work on
+    /// the machine stretches every phase.
+    pub load_average: [Option<f64>; 2],
+}
+
+fn load_average() -> Option<f64> {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()?
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()
 }
 
 fn same_mesh(a: &TetMesh, b: &TetMesh) -> bool {
@@ -112,6 +124,7 @@ pub fn bench_fem_mesh(
     repeats: usize,
     ccx: bool,
 ) -> Result<MeshPathBench> {
+    let load_before = load_average();
     let config = StudyConfig::load(None)?;
     let work = tempfile::tempdir()?;
     let mut phases: Vec<(String, f64, bool)> = Vec::new();
@@ -268,12 +281,16 @@ pub fn bench_fem_mesh(
         })
         .collect();
 
-    let mut runs = Vec::new();
-    for extra in [vec![], vec!["--no-pictures".to_string()]] {
-        runs.push(whole_run(design_file, mesh_file, force_n, repeats, &extra)?);
-    }
+    let runs = whole_runs(
+        design_file,
+        mesh_file,
+        force_n,
+        repeats,
+        &[vec![], vec!["--no-pictures".to_string()]],
+    )?;
     let ccx = if ccx {
-        Some(ccx_run(&mesh, force_n, work.path(), r, runs[0].wall_s)?)
+        let walls: Vec<f64> = runs.iter().map(|r| r.wall_s).collect();
+        Some(ccx_run(&mesh, force_n, work.path(), r, &walls)?)
     } else {
         None
     };
@@ -292,53 +309,63 @@ pub fn bench_fem_mesh(
         phases,
         runs,
         ccx,
+        load_average: [load_before, load_average()],
     })
 }
 
-/// `rodstudy fem DESIGN --mesh FILE --force F --json --out TMP [extra]`, `repeats` times.
-fn whole_run(
+/// `rodstudy fem DESIGN --mesh FILE --force F --json --out TMP [extra]` for each of `variants`,
+/// `repeats` times, interleaved (so that other work on the machine falls on all alike).
+fn whole_runs(
     design: &Path,
     mesh: &Path,
     force_n: f64,
     repeats: usize,
-    extra: &[String],
-) -> Result<WholeRun> {
+    variants: &[Vec<String>],
+) -> Result<Vec<WholeRun>> {
     let exe = std::env::current_exe()?;
-    let mut rows = Vec::new();
+    let mut rows = vec![Vec::new(); variants.len()];
     for _ in 0..repeats.max(1) {
-        let out = tempfile::tempdir()?;
-        let t0 = Instant::now();
-        let o = Command::new(&exe)
-            .arg("fem")
-            .arg(design)
-            .arg("--mesh")
-            .arg(mesh)
-            .args(["--force", &force_n.to_string(), "--json", "--out"])
-            .arg(out.path())
-            .args(extra)
-            .output()?;
-        let wall = t0.elapsed().as_secs_f64();
-        if !o.status.success() {
-            bail!(
-                "rodstudy fem --mesh {}: {}",
-                mesh.display(),
-                String::from_utf8_lossy(&o.stderr).trim()
-            );
+        for (extra, rows) in variants.iter().zip(&mut rows) {
+            let out = tempfile::tempdir()?;
+            let t0 = Instant::now();
+            let o = Command::new(&exe)
+                .arg("fem")
+                .arg(design)
+                .arg("--mesh")
+                .arg(mesh)
+                .args(["--force", &force_n.to_string(), "--json", "--out"])
+                .arg(out.path())
+                .args(extra)
+                .output()?;
+            let wall = t0.elapsed().as_secs_f64();
+            if !o.status.success() {
+                bail!(
+                    "rodstudy fem --mesh {}: {}",
+                    mesh.display(),
+                    String::from_utf8_lossy(&o.stderr).trim()
+                );
+            }
+            let v: serde_json::Value = serde_json::from_slice(&o.stdout)?;
+            let total = v["fem"]["total_s"].as_f64().unwrap_or(f64::NAN);
+            let mesh_s = v["mesh"]["seconds"].as_f64().unwrap_or(f64::NAN);
+            rows.push((wall, total, mesh_s));
         }
-        let v: serde_json::Value = serde_json::from_slice(&o.stdout)?;
-        let total = v["fem"]["total_s"].as_f64().unwrap_or(f64::NAN);
-        let mesh_s = v["mesh"]["seconds"].as_f64().unwrap_or(f64::NAN);
-        rows.push((wall, total, mesh_s));
     }
-    rows.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let (wall_s, fem_total_s, mesh_s) = rows[rows.len() / 2];
-    Ok(WholeRun {
-        extra_args: extra.to_vec(),
-        wall_s,
-        fem_total_s,
-        mesh_s,
-        ratio_to_fem_total: wall_s / fem_total_s,
-    })
+    Ok(variants
+        .iter()
+        .zip(rows)
+        .map(|(extra, mut rows)| {
+            rows.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let (wall_s, fem_total_s, mesh_s) = rows[rows.len() / 2];
+            WholeRun {
+                extra_args: extra.clone(),
+                wall_s,
+                fem_total_s,
+                mesh_s,
+                ratio_to_fem_total: wall_s / fem_total_s,
+            }
+        })
+        .collect())
 }
 
 /// CalculiX on `mesh` (rod frame) through `pipeline/ccx_peer.py --json`.
@@ -347,7 +374,7 @@ fn ccx_run(
     force_n: f64,
     work: &Path,
     ours: &crate::fem::FemResult,
-    fem_run_wall_s: f64,
+    fem_runs_wall_s: &[f64],
 ) -> Result<CcxRun> {
     let rodmesh = work.join("rod_frame.rodmesh");
     crate::mesher::write_rodmesh(mesh, &rodmesh)?;
@@ -380,7 +407,7 @@ fn ccx_run(
             ours.fx.max_von_mises_averaged_mpa,
             ours.fy.max_von_mises_averaged_mpa,
         ],
-        ratio_fem_run_to_ccx: fem_run_wall_s / ccx_wall_s,
+        ratio_fem_runs_to_ccx: fem_runs_wall_s.iter().map(|w| w / ccx_wall_s).collect(),
     })
 }
 
@@ -400,6 +427,13 @@ pub fn markdown(b: &MeshPathBench) -> String {
         b.force_n,
         b.repeats
     );
+    if let [Some(a), Some(z)] = b.load_average {
+        let _ = writeln!(
+            s,
+            "load average {a:.1} before, {z:.1} after, on {} cores\n",
+            std::thread::available_parallelism().map_or(0, |n| n.get())
+        );
+    }
     let _ = writeln!(
         s,
         "| phase | time [s] | × (native read + analysis) | in `fem --mesh` |\n|---|---|---|---|"
@@ -438,11 +472,25 @@ pub fn markdown(b: &MeshPathBench) -> String {
         );
     }
     if let Some(c) = &b.ccx {
+        let ratios: Vec<String> = b
+            .runs
+            .iter()
+            .zip(&c.ratio_fem_runs_to_ccx)
+            .map(|(r, x)| {
+                format!(
+                    "`--json{}` {x:.2}",
+                    r.extra_args
+                        .iter()
+                        .map(|a| format!(" {a}"))
+                        .collect::<String>()
+                )
+            })
+            .collect();
         let _ = writeln!(
             s,
-            "\nCalculiX (ccx_peer.py, both cases, SPOOLES): {:.2} s; `fem --mesh --json` / ccx: {:.3}; averaged von Mises F_x {:.4} / {:.4} MPa, F_y {:.4} / {:.4} MPa (ccx / ours)",
+            "\nCalculiX on the same mesh (`pipeline/ccx_peer.py`, both cases, SPOOLES): {:.2} s; `fem --mesh` / ccx: {}; averaged von Mises F_x {:.4} / {:.4} MPa, F_y {:.4} / {:.4} MPa (ccx / ours)",
             c.ccx_wall_s,
-            c.ratio_fem_run_to_ccx,
+            ratios.join(", "),
             c.max_von_mises_averaged_mpa[0],
             c.ours_max_von_mises_averaged_mpa[0],
             c.max_von_mises_averaged_mpa[1],
