@@ -2,6 +2,7 @@
 //! are ratios that travel between machines better than seconds.
 
 pub mod fem_convergence;
+pub mod fem_mesh;
 pub mod fem_rod;
 pub mod mass;
 

@@ -1,4 +1,6 @@
-//! `rodstudy bench mass [--triangles N] [--repeats R] [--json]`
+//! `rodstudy bench mass [--triangles N] [--repeats R] [--json]`, `bench fem [DESIGN...] [--size MM]
+//! [--force N] [--json]`, `bench fem DESIGN --mesh FILE [--force N] [--repeats K] [--ccx] [--json]`,
+//! `bench dynamics [DESIGN]`
 
 use crate::bench::mass::bench_mass;
 use crate::mechanism::{DrivenScene, MechanismParams, RodInertia, bench_driven};
@@ -23,9 +25,21 @@ pub enum BenchCommand {
     },
     /// Stage 3: mesh, assembly, symbolic analysis, factorisation, solve and stress times and
     /// peak memory per design at one mesh size (each design in its own process for the memory).
+    /// With `--mesh FILE`: the fixed-mesh path of one design (`fem DESIGN --mesh FILE`) phase by
+    /// phase: read (native and meshio), rod-frame mapping, analysis, VTU, pictures, and the whole
+    /// command with and without pictures.
     Fem {
-        /// STL designs (default: every design in designs/).
+        /// STL designs (default: every design in designs/; exactly one with `--mesh`).
         designs: Vec<PathBuf>,
+        /// A volume mesh of the design (in its units and pose): time the fixed-mesh path.
+        #[arg(long)]
+        mesh: Option<PathBuf>,
+        /// With `--mesh`: repeats per phase; the median is reported.
+        #[arg(long, default_value_t = 3, requires = "mesh")]
+        repeats: usize,
+        /// With `--mesh`: also run CalculiX on the same mesh (pipeline/ccx_peer.py).
+        #[arg(long, requires = "mesh")]
+        ccx: bool,
         /// Element size [mm].
         #[arg(long, default_value_t = 5.0)]
         size: f64,
@@ -84,9 +98,19 @@ pub fn run(command: BenchCommand) -> Result<i32> {
         }
         BenchCommand::Fem {
             designs,
+            mesh: Some(mesh),
+            repeats,
+            ccx,
+            force,
+            json,
+            ..
+        } => bench_fem_mesh(designs, &mesh, force, repeats, ccx, json),
+        BenchCommand::Fem {
+            designs,
             size,
             force,
             json,
+            ..
         } => bench_fem(designs, size, force, json),
         BenchCommand::Dynamics {
             design,
@@ -140,6 +164,35 @@ pub fn run(command: BenchCommand) -> Result<i32> {
             Ok(0)
         }
     }
+}
+
+/// `bench fem DESIGN --mesh FILE`: [`crate::bench::fem_mesh`].
+fn bench_fem_mesh(
+    designs: Vec<PathBuf>,
+    mesh: &std::path::Path,
+    force: Option<f64>,
+    repeats: usize,
+    ccx: bool,
+    json: bool,
+) -> Result<i32> {
+    let [design] = designs.as_slice() else {
+        anyhow::bail!("bench fem --mesh FILE takes exactly one design (the STL the mesh is of)");
+    };
+    let force = match force {
+        Some(f) if f.is_finite() && f > 0.0 => f,
+        Some(f) => anyhow::bail!("--force must be a positive number of newtons, got {f}"),
+        None => {
+            let config = crate::config::StudyConfig::load(None)?;
+            super::fem::peak_force(&stages::mass::load(design)?, &config)?
+        }
+    };
+    let b = crate::bench::fem_mesh::bench_fem_mesh(design, mesh, force, repeats, ccx)?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&b)?);
+    } else {
+        print!("{}", crate::bench::fem_mesh::markdown(&b));
+    }
+    Ok(0)
 }
 
 /// Runs `rodstudy fem --json` for each design in a child process (so VmHWM is that design's own

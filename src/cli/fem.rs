@@ -1,4 +1,4 @@
-//! `rodstudy fem DESIGN [--mesh FILE] [--size MM] [--force N] [--json] [--out DIR]
+//! `rodstudy fem DESIGN [--mesh FILE] [--size MM] [--force N] [--json] [--no-pictures] [--out DIR]
 //! [--refine 8,5,3.5]`
 
 use super::mesh_args::MeshArgs;
@@ -29,6 +29,9 @@ pub struct FemArgs {
     /// Print the result as JSON.
     #[arg(long)]
     json: bool,
+    /// Write the VTU files only, not the von Mises pictures (von_mises_fx.svg, _fy.svg).
+    #[arg(long)]
+    no_pictures: bool,
     /// Refinement study over these element sizes [mm] instead of one analysis, e.g. 8,5,3.5.
     #[arg(long, value_delimiter = ',')]
     refine: Option<Vec<f64>>,
@@ -103,13 +106,23 @@ pub fn run(args: FemArgs) -> Result<i32> {
         return Ok(0);
     }
     let mut outcome = stages::fem::fem(&design, force, &config, &args.out.join("mesh"), &mode)?;
-    crate::report::fields::write_fem_fields(
-        &mut outcome.record.fem,
-        &outcome.solution,
-        &outcome.mesh.mesh,
-        &args.out,
-        "fem",
-    )?;
+    if args.no_pictures {
+        crate::report::fields::write_fem_vtus(
+            &mut outcome.record.fem,
+            &outcome.solution,
+            &outcome.mesh.mesh,
+            &args.out,
+            "fem",
+        )?;
+    } else {
+        crate::report::fields::write_fem_fields(
+            &mut outcome.record.fem,
+            &outcome.solution,
+            &outcome.mesh.mesh,
+            &args.out,
+            "fem",
+        )?;
+    }
     let result = outcome.record;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&FemJson::from(&result))?);

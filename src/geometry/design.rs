@@ -21,9 +21,9 @@ use super::mechanism_frame::{MechanismFrame, RodInFrame};
 use super::sidecar::DesignSettings;
 use super::step::{STEP_SCRIPT, StepReport, is_step, read_step};
 use super::stl_file::{StlFormat, read_stl_file};
-use crate::python_env::{pipeline_script, python};
 use super::validate::validate;
 use super::weld::{IndexedMesh, weld};
+use crate::python_env::{pipeline_script, python};
 use anyhow::{Context, Result, bail};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -525,7 +525,10 @@ pub fn find_stl_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
                 .collect();
             found.retain(|p| is_step(p) || !stems_with_step.contains(&p.with_extension("")));
             if found.is_empty() {
-                bail!("{}: no .stl files in this folder (nor .step/.stp)", path.display());
+                bail!(
+                    "{}: no .stl files in this folder (nor .step/.stp)",
+                    path.display()
+                );
             }
             files.extend(found);
         } else if path.is_file() {

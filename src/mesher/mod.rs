@@ -6,11 +6,17 @@
 //! [`rod_mesher::GmshRodMesher`] puts these together behind [`crate::fem::adapt::Mesher`], the
 //! small trait the adaptive loop calls, so that the loop itself can be driven by an in-memory
 //! mesher in tests.
+//!
+//! A user's ready volume mesh is read by [`volume::read_volume_mesh`]: gmsh MSH 4.1 ([`msh`], via
+//! the `mshio` crate) and Abaqus/CalculiX `.inp` ([`inp`]) natively, other formats through meshio.
 
 pub mod gmsh;
+pub mod inp;
+pub mod msh;
 pub mod rod_mesher;
 pub mod rodmesh;
 pub mod size_field;
+pub mod volume;
 
 pub use gmsh::{
     MeshReport, MeshRequest, MeshedRod, StepInRodFrame, convert_mesh, mesh_step_with, mesh_stl,
@@ -18,6 +24,10 @@ pub use gmsh::{
 };
 pub use rod_mesher::GmshRodMesher;
 pub use rodmesh::{read_rodmesh, write_rodmesh};
+pub use volume::{
+    MESH_READER_VAR, VolumeReader, read_volume_mesh, read_volume_mesh_meshio,
+    read_volume_mesh_native, volume_reader,
+};
 
 /// The mesher script in `pipeline/`.
 pub const MESHER_SCRIPT: &str = "mesh_rod.py";

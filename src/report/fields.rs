@@ -27,6 +27,18 @@ pub fn write_fem_fields(
     dir: &Path,
     stem: &str,
 ) -> Result<()> {
+    write_fem_vtus(result, solution, mesh, dir, stem)?;
+    write_fem_pictures(result, solution, mesh, dir)
+}
+
+/// The ParaView files of [`write_fem_fields`] alone (`<dir>/<stem>_fx.vtu`, `_fy.vtu`).
+pub fn write_fem_vtus(
+    result: &mut FemResult,
+    solution: &RodSolution,
+    mesh: &TetMesh,
+    dir: &Path,
+    stem: &str,
+) -> Result<()> {
     std::fs::create_dir_all(dir).map_err(|e| FemError::io(dir, e))?;
     for c in 0..2 {
         let case = if c == 0 {
@@ -46,6 +58,24 @@ pub fn write_fem_fields(
             &solution.away_from_fixed,
         )?;
         case.vtu = Some(path);
+    }
+    Ok(())
+}
+
+/// The pictures of [`write_fem_fields`] alone (`<dir>/von_mises_fx.svg`, `_fy.svg`).
+pub fn write_fem_pictures(
+    result: &mut FemResult,
+    solution: &RodSolution,
+    mesh: &TetMesh,
+    dir: &Path,
+) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| FemError::io(dir, e))?;
+    for c in 0..2 {
+        let case = if c == 0 {
+            &mut result.fx
+        } else {
+            &mut result.fy
+        };
         let picture = dir.join(format!("von_mises_{}.svg", case.name));
         write_case_picture(&picture, mesh, &solution.stresses[c], case)?;
         case.picture = Some(picture);
