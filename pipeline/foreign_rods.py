@@ -208,6 +208,23 @@ def exact_properties(volumes) -> dict:
             "solids": len(volumes)}
 
 
+def declare_inches(text: str) -> str:
+    """gmsh writes every STEP in millimetres; a CAD system exporting a part drawn in inches declares
+    the inch instead (ISO 10303-41 conversion-based unit: 1 in = 25.4 mm), and a STEP reader
+    converts. The length unit entity of the file is replaced by that declaration."""
+    m = re.search(r"#(\d+) = \( LENGTH_UNIT\(\) NAMED_UNIT\(\*\) SI_UNIT\(\.MILLI\.,\.METRE\.\) \);", text)
+    if m is None:
+        raise RuntimeError("no millimetre length unit in the STEP gmsh wrote")
+    n = int(m.group(1))
+    top = max(int(k) for k in re.findall(r"^#(\d+) =", text, re.M))
+    a, b, c = top + 1, top + 2, top + 3
+    inch = (f"#{n} = ( CONVERSION_BASED_UNIT('INCH',#{a}) LENGTH_UNIT() NAMED_UNIT(#{b}) );\n"
+            f"#{a} = LENGTH_MEASURE_WITH_UNIT(LENGTH_MEASURE(25.4),#{c});\n"
+            f"#{b} = DIMENSIONAL_EXPONENTS(1.,0.,0.,0.,0.,0.,0.);\n"
+            f"#{c} = ( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.) );")
+    return text[:m.start()] + inch + text[m.end():]
+
+
 def write_rod(name: str, out: pathlib.Path) -> dict:
     volumes, facts = build(name)
     exact = exact_properties(volumes)
@@ -215,6 +232,8 @@ def write_rod(name: str, out: pathlib.Path) -> dict:
     gmsh.write(str(step))
     # the writer stamps the time into FILE_NAME: a fixed stamp keeps reruns byte-identical
     text = re.sub(r"'\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d'", "'2000-01-01T00:00:00'", step.read_text(), count=1)
+    if facts["units"] == "in":
+        text = declare_inches(text)
     step.write_text(text)
     entry = {"units": facts["units"], "crank_pin": facts["crank"], "piston_pin": facts["piston"],
              "crank_bore_radius": facts["ra"], "piston_bore_radius": facts["rb"], "pin_axis": facts["axis"],

@@ -364,7 +364,7 @@ def gmsh_step_mesh(step: pathlib.Path, frame: list, scale: float, size_mm: float
             gmsh.option.setNumber(k, v)
         gmsh.option.setNumber("Mesh.HighOrderOptimize", 2)
         gmsh.option.setNumber("Geometry.OCCScaling", 1.0)
-        gmsh.option.setString("Geometry.OCCTargetUnit", "")
+        gmsh.option.setString("Geometry.OCCTargetUnit", "MM")
         if delaunay:
             gmsh.option.setNumber("Mesh.Algorithm3D", 1)
         gmsh.model.add("rod")

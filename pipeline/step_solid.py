@@ -10,7 +10,8 @@ separate volumes and their properties add), and prints one JSON line:
   solids_in_file    the 3D entities the file holds
   volumes           the volumes after the fusion (1 for a bonded body)
   fused             whether several solids were fused
-  volume            exact volume of the B-rep, file units^3 (sum over the volumes)
+  (lengths are millimetres: OpenCASCADE converts from the unit the STEP file declares)
+  volume            exact volume of the B-rep, mm^3 (sum over the volumes)
   centroid          exact centre of volume, file units
   inertia           exact second moment tensor about the centroid, unit density, file units^5
                     (OpenCASCADE's MatrixOfInertia: I_ii = integral of the squared distance to
@@ -99,9 +100,9 @@ def cmd_read(args) -> dict:
         fail(f"{path}: no such file")
     md.gmsh_start()
     gmsh.option.setNumber("General.Verbosity", 1)
-    # read lengths as written (no unit conversion by OpenCASCADE's STEP reader)
+    # lengths in millimetres whatever unit the file declares (OpenCASCADE converts)
     gmsh.option.setNumber("Geometry.OCCScaling", 1.0)
-    gmsh.option.setString("Geometry.OCCTargetUnit", "")
+    gmsh.option.setString("Geometry.OCCTargetUnit", "MM")
     try:
         entities = gmsh.model.occ.importShapes(str(path))
     except Exception as e:  # gmsh raises a bare Exception with its last error

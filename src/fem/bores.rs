@@ -33,8 +33,19 @@ pub struct BoreSpec {
     pub radius_tolerance: f64,
     /// Largest angle between a bore face's inward normal and the radial direction, degrees (default 30).
     pub normal_tolerance_deg: f64,
-    /// Smallest accepted area / (2π r × axial length) of a bore set (default 0.85).
+    /// Smallest accepted area / (2π r × axial length) of a bore set (default 0.85), for a full
+    /// bore; a partial bore's is scaled by its arc.
     pub min_coverage: f64,
+    /// The arc the loaded and the fixed bore span, degrees: 360 for a full bore, less for a
+    /// partial one (a big end modelled without its cap); the load acts on the surface that exists.
+    #[serde(default = "full_arc")]
+    pub loaded_arc_deg: f64,
+    #[serde(default = "full_arc")]
+    pub fixed_arc_deg: f64,
+}
+
+fn full_arc() -> f64 {
+    360.0
 }
 
 impl Default for BoreSpec {
@@ -54,6 +65,8 @@ impl BoreSpec {
             radius_tolerance: 0.01,
             normal_tolerance_deg: 30.0,
             min_coverage: 0.85,
+            loaded_arc_deg: 360.0,
+            fixed_arc_deg: 360.0,
         }
     }
 
@@ -218,20 +231,34 @@ pub fn find_bore(
     }
     let length = zmax - zmin;
     let coverage = area_m2 / (2.0 * std::f64::consts::PI * r_bore * length);
-    let plausible = length > 0.0 && coverage >= spec.min_coverage && coverage <= 1.05;
+    // a partial bore (stage 1 measured its arc) covers that fraction of a full wall
+    let arc = match role {
+        BoreRole::Loaded => spec.loaded_arc_deg,
+        BoreRole::Fixed => spec.fixed_arc_deg,
+    }
+    .clamp(1.0, 360.0);
+    let share = arc / 360.0;
+    let plausible =
+        length > 0.0 && coverage >= spec.min_coverage * share && coverage <= 1.05 * share;
     if !plausible {
+        let what = if arc < 360.0 {
+            format!("an arc of {arc:.0}° of a cylinder wall (the partial bore stage 1 measured)")
+        } else {
+            "a full cylinder wall".to_string()
+        };
         return Err(implausible(format!(
             "{} faces at radius {:.3} mm cover {:.1} mm² over an axial length of {:.3} mm: {:.1} % of a \
-             full cylinder wall (expected {:.0}–105 %); is the pin centre right?",
+             full cylinder wall (expected {:.0}–{:.0} % for {what}); is the pin centre right (rod frame, mm)?",
             faces.len(),
             r_bore * 1e3,
             area_m2 * 1e6,
             length * 1e3,
             100.0 * coverage,
-            100.0 * spec.min_coverage
+            100.0 * spec.min_coverage * share,
+            105.0 * share
         )));
     }
-    if gap > 90.0 {
+    if gap > 90.0 + (360.0 - arc) {
         return Err(implausible(format!(
             "the faces at radius {:.3} mm leave a gap of {gap:.0}° around the axis",
             r_bore * 1e3

@@ -195,6 +195,13 @@ pub fn load_design(stl: &Path) -> Result<LoadedDesign> {
     let file = || stl.display().to_string();
     let scale = settings.units.to_metres();
     let (soup, format, mut warnings) = if is_step(stl) {
+        if settings.units != super::sidecar::Units::Mm {
+            bail!(
+                "{}: a STEP file declares its own length unit (OpenCASCADE converts it to mm): remove `units = \"{}\"` from the sidecar; pin centres in a STEP's sidecar are millimetres",
+                stl.display(),
+                settings.units.symbol()
+            );
+        }
         // the exact solid through gmsh/OpenCASCADE, and a triangulation of it for the bore
         // check, the frame and the stage-3 surface
         let python = python().with_context(file)?;

@@ -281,12 +281,13 @@ pub fn mesh_step_with(
         .map(|v| format!("{v:?}"))
         .collect::<Vec<_>>()
         .join(",");
+    // one argument `--frame=…`: a value that starts with "-" would read as an option
+    let frame = format!("--frame={frame}");
     let (size, scale) = (format!("{size_mm}"), format!("{:?}", step.scale));
     let mut args: Vec<&std::ffi::OsStr> = vec![
         "mesh-step".as_ref(),
         step.step.as_os_str(),
         out_dir.as_os_str(),
-        "--frame".as_ref(),
         frame.as_ref(),
     ];
     let tail: [&std::ffi::OsStr; 4] = [

@@ -145,9 +145,15 @@ impl Setup {
                 scale: to_metres * 1e3,
             }
         });
+        // a partial bore (a big end without its cap) is loaded or fixed on the arc that exists
+        let mut bores = surface.bores();
+        if let Ok(m) = crate::geometry::design::rod_mass(design) {
+            bores.loaded_arc_deg = m.pins.crank_bore_arc_deg;
+            bores.fixed_arc_deg = m.pins.piston_bore_arc_deg;
+        }
         Setup {
             step,
-            bores: surface.bores(),
+            bores,
             surface,
             material: Material::from(&config.fem),
             singular_edges,
