@@ -61,9 +61,9 @@ impl StepReport {
     pub fn description(&self) -> String {
         match (self.solids_in_file, self.volumes) {
             (1, _) => "STEP: one solid, exact B-rep mass properties".into(),
-            (n, 1) => format!(
-                "STEP: {n} solids fused into one bonded body, exact B-rep mass properties"
-            ),
+            (n, 1) => {
+                format!("STEP: {n} solids fused into one bonded body, exact B-rep mass properties")
+            }
             (n, v) => format!(
                 "STEP: {n} solids, {v} separate bodies after fusing those that touch (treated as one rigid part), exact B-rep mass properties"
             ),

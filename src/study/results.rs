@@ -124,7 +124,10 @@ mod tests {
             line.contains("Wrong topology of boundary mesh for parametrization"),
             "{line}"
         );
-        assert!(line.contains("try:") && line.contains("x/failure.log"), "{line}");
+        assert!(
+            line.contains("try:") && line.contains("x/failure.log"),
+            "{line}"
+        );
         // a one-line message stays as it is
         assert_eq!(one_line("x.stl: not an STL file", "x/failure.log"), None);
     }
