@@ -136,12 +136,14 @@ fn free(args: FreeArgs) -> Result<i32> {
     // the default caps grow with the simulated time; an explicit --max-steps is a total
     options = options.with_caps_for_duration();
     options.max_steps = args.max_steps.unwrap_or(options.max_steps);
-    let run = run_free(method, &options).map_err(|e| anyhow::anyhow!("{method}: {e}"))?;
+    let mut run = run_free(method, &options).map_err(|e| anyhow::anyhow!("{method}: {e}"))?;
+    // the exact reference where the scene has one; warns when the error exceeds 10× the
+    // tolerance
     let errors = options
         .scene
         .reference()
         .ok()
-        .map(|reference| reference.max_errors(&run.phi, &run.omega));
+        .map(|reference| run.check_against_reference(&reference, &options));
     let summary = FreeSummary {
         method: run.method.to_string(),
         model: run.model,

@@ -1,5 +1,6 @@
-//! `rodstudy integrators [--json] [--out DIR] [--repeats N]`: the work–precision comparison of
-//! the free run (thesis ch. 4) against the exact energy-integral reference.
+//! `rodstudy integrators [--json] [--out DIR] [--repeats N] [--t-end T]`: the work–precision
+//! comparison of the free run (thesis ch. 4) against the exact energy-integral reference; with
+//! `--t-end` other than 1 s, the long-horizon table (issue 21).
 
 use crate::free_run::{FreeScene, Method, SweepConfig, WorkPrecision, work_precision_sweep};
 use crate::report::atomic_write::write_atomic;
@@ -20,39 +21,76 @@ pub struct IntegratorsArgs {
     /// Repeats per run; the median CPU time is reported.
     #[arg(long, default_value_t = 5)]
     repeats: usize,
+    /// End time [s]. Other than 1: the long-horizon table (scene `free` run to T, output
+    /// every 1e-4·T s, the reduced-model methods, tolerances 1e-6 … 1e-12, caps of 5e5 steps
+    /// and 5e6 evaluations per simulated second; a method's tighter tolerances are skipped
+    /// once it reaches the cap), written to work_precision_<T>s.* beside the 1 s files.
+    #[arg(long, default_value_t = 1.0)]
+    t_end: f64,
 }
 
 pub fn run(args: IntegratorsArgs) -> Result<i32> {
-    let config = SweepConfig {
-        repeats: args.repeats,
-        ..SweepConfig::default()
+    let long = args.t_end != 1.0;
+    let (scene, config, stem) = if long {
+        let t = args.t_end;
+        let scene = FreeScene::long_run(t, 1e-4 * t);
+        let config = SweepConfig {
+            methods: vec![
+                Method::InitialAcceleration,
+                Method::Rk45,
+                Method::Rk23,
+                Method::Bdf,
+                Method::Rosenbrock,
+                Method::TrBdf2,
+            ],
+            tolerances: vec![1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12],
+            fixed_steps: vec![1e-4, 1e-5, 1e-6],
+            repeats: args.repeats,
+            max_steps: (5e5 * t.max(1.0)).ceil() as u64,
+            max_rhs_evals: (5e6 * t.max(1.0)).ceil() as u64,
+            ..SweepConfig::default()
+        };
+        (scene, config, format!("work_precision_{t}s"))
+    } else {
+        let config = SweepConfig {
+            repeats: args.repeats,
+            ..SweepConfig::default()
+        };
+        (FreeScene::thesis(), config, "work_precision".to_string())
     };
-    let wp =
-        work_precision_sweep(&FreeScene::thesis(), &config).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let wp = work_precision_sweep(&scene, &config).map_err(|e| anyhow::anyhow!("{e}"))?;
     let markdown = wp.to_markdown();
     if args.json {
         println!("{}", serde_json::to_string_pretty(&wp)?);
     } else {
         print!("{markdown}");
     }
-    write_atomic(&args.out.join("work_precision.md"), markdown.as_bytes())?;
+    let file = |ext: &str| args.out.join(format!("{stem}{ext}"));
+    write_atomic(&file(".md"), markdown.as_bytes())?;
     write_atomic(
-        &args.out.join("work_precision.json"),
+        &file(".json"),
         serde_json::to_string_pretty(&wp)?.as_bytes(),
     )?;
     let mut w = csv::Writer::from_writer(Vec::new());
     for row in &wp.rows {
         w.serialize(CsvRow::from(row))?;
     }
-    write_atomic(&args.out.join("work_precision.csv"), &w.into_inner()?)?;
+    write_atomic(&file(".csv"), &w.into_inner()?)?;
     let time = plot(&wp, "CPU time [s]", |r| r.cpu_s)?;
-    write_atomic(&args.out.join("work_precision_time.svg"), time.as_bytes())?;
+    write_atomic(&file("_time.svg"), time.as_bytes())?;
     let evals = plot(&wp, "right-hand-side evaluations", |r| r.rhs_evals as f64)?;
-    write_atomic(&args.out.join("work_precision_evals.svg"), evals.as_bytes())?;
+    write_atomic(&file("_evals.svg"), evals.as_bytes())?;
     eprintln!(
-        "wrote work_precision.md, .csv, .json, work_precision_time.svg, work_precision_evals.svg in {}",
+        "wrote {stem}.md, .csv, .json, {stem}_time.svg, {stem}_evals.svg in {}",
         args.out.display()
     );
+    let warned = wp.rows.iter().filter(|r| !r.warnings.is_empty()).count();
+    if warned > 0 {
+        eprintln!(
+            "warning: {warned} runs carry warnings (error above 10× the tolerance, tolerance \
+             floor, energy drift): see the `warnings` of {stem}.json"
+        );
+    }
     let non_monotone: Vec<String> = config
         .methods
         .iter()
@@ -129,7 +167,7 @@ fn plot(
     line_chart(
         "Scene free (thesis ch. 4): error against the exact reference",
         cost_label,
-        "max |Δφ| over [0, 1] s [rad]",
+        &format!("max |Δφ| over [0, {}] s [rad]", wp.scene.t_end),
         &series,
         Scale::Log,
         Scale::Log,

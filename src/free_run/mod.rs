@@ -43,7 +43,7 @@ pub use reduced::{ModelError, ReducedModel, TwoMassRod};
 pub use reference::{
     ExactReference, PANEL_TOL, ReferenceError, exact_reference, exact_reference_with_tol,
 };
-pub use run::{ENERGY_WARN_REL, FreeRunOptions, FreeRunResult, run_free};
+pub use run::{ENERGY_WARN_REL, FreeRunOptions, FreeRunResult, REFERENCE_WARN_FACTOR, run_free};
 pub use scene::FreeScene;
 pub use sweep::{SweepConfig, SweepRow, WorkPrecision, work_precision_sweep};
 

@@ -38,4 +38,10 @@ impl OdeSystem for CrankOde<'_> {
     fn is_autonomous(&self) -> bool {
         true
     }
+
+    /// φ: the mechanism, its loads (crank torque, piston force, gas spring on the piston
+    /// travel, gravity through sin/cos φ) and so `φ̈` repeat every turn.
+    fn period(&self, i: usize) -> Option<f64> {
+        (i == 0).then_some(std::f64::consts::TAU)
+    }
 }

@@ -89,6 +89,8 @@ pub struct SweepRow {
     pub energy_drift_max_j: Option<f64>,
     /// DAE forms: largest constraint violation on the grid.
     pub constraint_drift_max: Option<ConstraintViolation>,
+    /// Warnings of the run (tolerance floor, error above 10× the tolerance, energy drift).
+    pub warnings: Vec<String>,
 }
 
 /// The sweep's result.
@@ -144,7 +146,7 @@ impl WorkPrecision {
             let fmt = |v: Option<f64>| v.map_or("–".to_string(), |x| format!("{x:.2e}"));
             let _ = writeln!(
                 s,
-                "| {} | {} = {:.0e} | {} | {} | {} | {} | {} | {:.3}{} |",
+                "| {} | {} = {:.0e} | {} | {} | {} | {} | {} | {}{} |",
                 r.method,
                 r.setting,
                 r.value,
@@ -153,7 +155,11 @@ impl WorkPrecision {
                 r.steps,
                 r.rhs_evals,
                 r.jac_evals,
-                r.cpu_s * 1e3,
+                if r.cpu_s.is_nan() {
+                    "–".to_string()
+                } else {
+                    format!("{:.3}", r.cpu_s * 1e3)
+                },
                 r.failure
                     .as_ref()
                     .map_or(String::new(), |f| format!(" (failed: {f})")),
@@ -164,7 +170,9 @@ impl WorkPrecision {
 }
 
 /// Runs every method of `cfg` over its tolerances (or steps) on `scene` and measures the
-/// error against the exact reference on the output grid.
+/// error against the exact reference on the output grid. Once a method has reached its step
+/// or evaluation cap, its tighter settings (which would need more work) are not run: their
+/// rows carry the failure "not run: …" with zero work.
 pub fn work_precision_sweep(
     scene: &FreeScene,
     cfg: &SweepConfig,
@@ -181,7 +189,29 @@ pub fn work_precision_sweep(
         } else {
             ("atol", &cfg.tolerances)
         };
+        let mut capped: Option<f64> = None;
         for &value in values {
+            if let Some(at) = capped {
+                rows.push(SweepRow {
+                    method,
+                    setting,
+                    value,
+                    failure: Some(format!(
+                        "not run: the cap was already reached at {setting} = {at:e}"
+                    )),
+                    max_err_phi_rad: None,
+                    max_err_omega_rad_s: None,
+                    steps: 0,
+                    rhs_evals: 0,
+                    jac_evals: 0,
+                    lu_decompositions: 0,
+                    cpu_s: f64::NAN,
+                    energy_drift_max_j: None,
+                    constraint_drift_max: None,
+                    warnings: Vec::new(),
+                });
+                continue;
+            }
             let opts = FreeRunOptions {
                 scene: *scene,
                 rtol: 0.0,
@@ -212,8 +242,8 @@ pub fn work_precision_sweep(
             times.sort_by(f64::total_cmp);
             let cpu_s = times.get(times.len() / 2).copied().unwrap_or(f64::NAN);
             rows.push(match last {
-                Some(Ok(r)) => {
-                    let (ep, ew) = reference.max_errors(&r.phi, &r.omega);
+                Some(Ok(mut r)) => {
+                    let (ep, ew) = r.check_against_reference(&reference, &opts);
                     SweepRow {
                         method,
                         setting,
@@ -228,23 +258,30 @@ pub fn work_precision_sweep(
                         cpu_s,
                         energy_drift_max_j: r.energy_drift_max_j,
                         constraint_drift_max: r.constraint_drift_max,
+                        warnings: r.warnings,
                     }
                 }
-                Some(Err(e)) => SweepRow {
-                    method,
-                    setting,
-                    value,
-                    failure: Some(e.to_string()),
-                    max_err_phi_rad: None,
-                    max_err_omega_rad_s: None,
-                    steps: e.stats.steps,
-                    rhs_evals: e.stats.rhs_evals,
-                    jac_evals: e.stats.jac_evals,
-                    lu_decompositions: e.stats.lu_decompositions,
-                    cpu_s,
-                    energy_drift_max_j: None,
-                    constraint_drift_max: None,
-                },
+                Some(Err(e)) => {
+                    if e.is_limit() {
+                        capped = Some(value);
+                    }
+                    SweepRow {
+                        method,
+                        setting,
+                        value,
+                        failure: Some(e.to_string()),
+                        max_err_phi_rad: None,
+                        max_err_omega_rad_s: None,
+                        steps: e.stats.steps,
+                        rhs_evals: e.stats.rhs_evals,
+                        jac_evals: e.stats.jac_evals,
+                        lu_decompositions: e.stats.lu_decompositions,
+                        cpu_s,
+                        energy_drift_max_j: None,
+                        constraint_drift_max: None,
+                        warnings: Vec::new(),
+                    }
+                }
                 None => unreachable!("at least one repeat"),
             });
         }

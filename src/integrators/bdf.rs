@@ -18,13 +18,22 @@
 //! orders `k − 1`, `k`, `k + 1` are compared and the one allowing the largest step is taken.
 //! Dense output: the interpolating polynomial of the accepted step (degree `k`, through
 //! `y_{n+1}, …, y_{n+1−k}`), evaluated before any order or step change.
+//!
+//! Precision over long runs: Newton iterates on the increment `y_{n+1} − y_n` (the
+//! predictor `Σ_{j≥1} ∇^j y_n` and the corrector relative to `D_0 = y_n`, `f` evaluated at
+//! the rounded `y_n + z`), and `D_0 ← D_0 + ∇y_{n+1}` is a compensated sum (Kahan 1965,
+//! Neumaier 1974; see [`super::adaptive`]), so that a growing state keeps the precision of its
+//! increments instead of losing up to half an ulp per step; periodic components are held as
+//! whole periods plus a remainder (`turns.rs`).
 
+use super::adaptive::compensated_add;
 use super::control::{check_underflow, initial_step, max_step, min_step};
 use super::eval::Evaluator;
 use super::grid::Recorder;
 use super::input::{check_input, invalid};
 use super::newton::{IterationMatrix, Newton, iteration_matrix};
 use super::norm::{Weights, rms_norm};
+use super::turns::Turns;
 use super::{OdeSystem, OutputGrid, Solution, SolverError, SolverOptions};
 use nalgebra::{DMatrix, DVector};
 
@@ -140,6 +149,18 @@ pub fn solve<S: OdeSystem + ?Sized>(
     let mut t = t0;
 
     let mut y_pred = DVector::zeros(n);
+    // predictor and corrector relative to d[0] = y_n (increment form), and the compensation
+    // of d[0] (the exact y_n is d[0] + comp)
+    let mut pred_inc = DVector::zeros(n);
+    let mut z_inc = DVector::zeros(n);
+    let mut comp = DVector::zeros(n);
+    let mut y_n = DVector::zeros(n);
+    // periodic components as whole periods + remainder (turns.rs)
+    let mut turns = Turns::new(sys, n, true);
+    let mut y_full = DVector::zeros(n);
+    if turns.wrap(&mut d[0], &mut comp) {
+        weights.set_offset(turns.offset());
+    }
     let mut psi = DVector::zeros(n);
     let mut base = DVector::zeros(n);
     let mut y_new = DVector::zeros(n);
@@ -172,18 +193,20 @@ pub fn solve<S: OdeSystem + ?Sized>(
                     check_underflow(&ev, t, h_abs)?;
                 }
             }
-            y_pred.fill(0.0);
-            for dj in d.iter().take(order + 1) {
-                y_pred += dj;
+            pred_inc.fill(0.0);
+            for dj in d.iter().take(order + 1).skip(1) {
+                pred_inc += dj;
             }
+            y_pred.copy_from(&d[0]);
+            y_pred += &pred_inc;
             weights.fill_scale(&mut scale, &y_pred);
             psi.fill(0.0);
             for j in 1..=order {
                 psi.axpy(gamma[j] / alpha[order], &d[j], 1.0);
             }
             let c = h_abs / alpha[order];
-            // z = y_pred + d with z = (y_pred − psi) + c f(z)
-            base.copy_from(&y_pred);
+            // z = y_pred + d with z = (y_pred − psi) + c f(z), relative to y_n = d[0]
+            base.copy_from(&pred_inc);
             base -= &psi;
             let mut converged = false;
             let mut iters = 0;
@@ -193,8 +216,9 @@ pub fn solve<S: OdeSystem + ?Sized>(
                     lu = iteration_matrix(&jac, c);
                 }
                 if let Some(w) = lu.as_ref() {
-                    y_new.copy_from(&y_pred);
-                    let out = newton.solve(&mut ev, w, t_new, &base, c, &mut y_new, &scale)?;
+                    z_inc.copy_from(&pred_inc);
+                    let out =
+                        newton.solve(&mut ev, w, t_new, &base, c, &d[0], &mut z_inc, &scale)?;
                     converged = out.converged;
                     iters = out.iters;
                 }
@@ -213,10 +237,12 @@ pub fn solve<S: OdeSystem + ?Sized>(
                 lu = None;
                 continue;
             }
+            y_new.copy_from(&d[0]);
+            y_new += &z_inc;
             let safety =
                 0.9 * (2 * NEWTON_MAXITER + 1) as f64 / (2 * NEWTON_MAXITER + iters) as f64;
-            dd.copy_from(&y_new);
-            dd -= &y_pred;
+            dd.copy_from(&z_inc);
+            dd -= &pred_inc;
             weights.fill_scale(&mut scale, &y_new);
             err.copy_from(&dd);
             err *= error_const[order];
@@ -242,14 +268,25 @@ pub fn solve<S: OdeSystem + ?Sized>(
             d[order + 2][i] = dd[i] - d[order + 1][i];
             d[order + 1][i] = dd[i];
         }
-        for i in (0..=order).rev() {
+        for i in (1..=order).rev() {
             let (lo, hi) = d.split_at_mut(i + 1);
             lo[i] += &hi[0];
+        }
+        y_n.copy_from(&d[0]);
+        {
+            let (d0, rest) = d.split_at_mut(1);
+            compensated_add(&y_n, &rest[0], &mut comp, &mut d0[0]);
+        }
+        y_new.copy_from(&d[0]);
+        turns.full(&y_new, &mut y_full);
+        if weights.take_floored() {
+            ev.stats.floored_steps += 1;
         }
         ev.accept_step(t_new);
         {
             let d_ref = &d;
-            rec.record(t, t_new, &y_new, |theta, out| {
+            let offset = turns.offset();
+            rec.record(t, t_new, &y_full, |theta, out| {
                 out.copy_from(&d_ref[0]);
                 let mut p = 1.0;
                 for (j, dj) in d_ref.iter().enumerate().take(order + 1).skip(1) {
@@ -257,7 +294,11 @@ pub fn solve<S: OdeSystem + ?Sized>(
                     p *= (theta - 1.0 + m) / (m + 1.0);
                     out.axpy(p, dj, 1.0);
                 }
+                *out += offset;
             });
+        }
+        if turns.wrap(&mut d[0], &mut comp) {
+            weights.set_offset(turns.offset());
         }
         t = t_new;
         if t_new >= t_end {

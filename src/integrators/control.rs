@@ -69,12 +69,17 @@ pub(crate) fn check_underflow<S: OdeSystem + ?Sized>(
 }
 
 /// Clamps a step so that it ends exactly at `t_end`; returns `(h, t_new, last)`. A step
-/// that would leave a remainder shorter than 1 % of itself is stretched to the end.
+/// that would leave a remainder shorter than 1 % of itself is stretched to the end. The step
+/// returned is `t_new − t` (exact by Sterbenz's lemma), not the `h` asked for, so that the
+/// stages and the recorded times agree to the last bit (SciPy's `solve_ivp` does the same);
+/// with `fl(t + h) ≠ t + h` the time would otherwise drift from `Σ h` by up to half an ulp of
+/// `t` per step.
 pub(crate) fn clamp_to_end(t: f64, h: f64, t_end: f64) -> (f64, f64, bool) {
     if t + 1.01 * h >= t_end {
         (t_end - t, t_end, true)
     } else {
-        (h, t + h, false)
+        let t_new = t + h;
+        (t_new - t, t_new, false)
     }
 }
 

@@ -69,6 +69,7 @@ mod stats;
 mod system;
 #[cfg(test)]
 mod tests_common;
+mod turns;
 
 pub mod bdf;
 pub mod genalpha;
@@ -82,7 +83,7 @@ pub mod trbdf2;
 pub use error::{FailureKind, SolverError};
 pub use grid::{OutputGrid, Solution};
 pub use method::{OdeMethod, solve};
-pub use norm::rms_norm_scaled;
+pub use norm::{TOL_FLOOR_KAPPA, rms_norm_scaled};
 pub use options::{JacobianSource, SolverOptions};
 pub use projection::StepProjection;
 pub use stats::Stats;

@@ -35,6 +35,8 @@ pub(crate) struct Newton {
     pub(crate) kappa: f64,
     f: DVector<f64>,
     dz: DVector<f64>,
+    /// `offset + z` (the evaluation point in increment form).
+    at: DVector<f64>,
 }
 
 /// Result of one Newton solve.
@@ -50,10 +52,16 @@ impl Newton {
             kappa,
             f: DVector::zeros(n),
             dz: DVector::zeros(n),
+            at: DVector::zeros(n),
         }
     }
 
-    /// Iterates `z ← z + W⁻¹ (base + gh f(t, z) − z)` with `W = I − gh J` already factored.
+    /// Iterates `z ← z + W⁻¹ (base + gh f(t, offset + z) − z)` with `W = I − gh J` already
+    /// factored. With `offset = y_n` the unknown is the increment `z = y_{n+1} − y_n` (and
+    /// `base` is given relative to `y_n` too): the increment is then kept to its own
+    /// precision, not to an ulp of `y`, so that the caller can add it to the state by
+    /// compensated summation ([`super::adaptive`]); `f` is evaluated at the rounded
+    /// `offset + z`. The round-off level of the convergence test is that of `offset + z`.
     /// Stops when the predicted remaining error `ρ/(1−ρ) ‖Δz‖` is below κ, when `‖Δz‖` is at
     /// roundoff level, or fails when the iteration diverges (`ρ ≥ 1`), would not converge
     /// within the limit, or meets a non-finite value (the caller then shrinks the step).
@@ -65,11 +73,16 @@ impl Newton {
         t: f64,
         base: &DVector<f64>,
         gh: f64,
+        offset: &DVector<f64>,
         z: &mut DVector<f64>,
         scale: &DVector<f64>,
     ) -> Result<NewtonOutcome, SolverError> {
         let n = z.len();
-        let floor = 20.0 * f64::EPSILON * (0..n).map(|i| z[i].abs() / scale[i]).fold(0.0, f64::max);
+        let floor = 20.0
+            * f64::EPSILON
+            * (0..n)
+                .map(|i| (offset[i] + z[i]).abs() / scale[i])
+                .fold(0.0, f64::max);
         let mut norm_old = f64::NAN;
         for k in 0..self.max_iter {
             ev.stats.newton_iters += 1;
@@ -79,7 +92,10 @@ impl Newton {
                     iters: k + 1,
                 });
             }
-            ev.rhs(t, z, &mut self.f)?;
+            for i in 0..n {
+                self.at[i] = offset[i] + z[i];
+            }
+            ev.rhs(t, &self.at, &mut self.f)?;
             if !self.f.iter().all(|v| v.is_finite()) {
                 return Ok(NewtonOutcome {
                     converged: false,

@@ -61,8 +61,9 @@ impl AdaptiveStepper for BogackiShampine {
         step: &Step,
         y: &DVector<f64>,
         y_new: &mut DVector<f64>,
+        dy: &mut DVector<f64>,
     ) -> Result<Attempt, SolverError> {
-        let Step { t, h, t_new } = *step;
+        let Step { t, h, t_new, .. } = *step;
         let ([k1, k2, k3, k4], ys, err) = (&mut self.k, &mut self.ys, &mut self.err);
         ys.copy_from(y);
         ys.axpy(0.5 * h, k1, 1.0);
@@ -71,7 +72,8 @@ impl AdaptiveStepper for BogackiShampine {
         ys.axpy(0.75 * h, k2, 1.0);
         ev.rhs(t + 0.75 * h, ys, k3)?;
         for i in 0..y.len() {
-            y_new[i] = y[i] + h * (2.0 / 9.0 * k1[i] + 1.0 / 3.0 * k2[i] + 4.0 / 9.0 * k3[i]);
+            dy[i] = h * (2.0 / 9.0 * k1[i] + 1.0 / 3.0 * k2[i] + 4.0 / 9.0 * k3[i]);
+            y_new[i] = y[i] + dy[i];
         }
         ev.rhs(t_new, y_new, k4)?;
         for i in 0..y.len() {

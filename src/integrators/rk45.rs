@@ -136,8 +136,9 @@ impl AdaptiveStepper for DormandPrince {
         step: &Step,
         y: &DVector<f64>,
         y_new: &mut DVector<f64>,
+        dy: &mut DVector<f64>,
     ) -> Result<Attempt, SolverError> {
-        let Step { t, h, t_new } = *step;
+        let Step { t, h, t_new, .. } = *step;
         let Self { k, ys, err } = self;
         let n = y.len();
         for s in 1..7 {
@@ -147,7 +148,9 @@ impl AdaptiveStepper for DormandPrince {
                 for (j, kj) in k.iter().enumerate().take(s) {
                     acc += A[s][j] * kj[i];
                 }
-                ys[i] = y[i] + h * acc;
+                // the last stage's increment is the step's (A[6] = b, FSAL)
+                dy[i] = h * acc;
+                ys[i] = y[i] + dy[i];
             }
             let ts = if s >= 5 { t_new } else { t + C[s] * h };
             ev.rhs(ts, ys, &mut k[s])?;

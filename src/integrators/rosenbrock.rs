@@ -100,8 +100,9 @@ impl AdaptiveStepper for Rosenbrock23 {
         step: &Step,
         y: &DVector<f64>,
         y_new: &mut DVector<f64>,
+        dy: &mut DVector<f64>,
     ) -> Result<Attempt, SolverError> {
-        let Step { t, h, t_new } = *step;
+        let Step { t, h, t_new, .. } = *step;
         ev.stats.lu_decompositions += 1;
         let Some(w) = iteration_matrix(&self.jac, h * D) else {
             return Ok(Attempt::Failed {
@@ -122,8 +123,10 @@ impl AdaptiveStepper for Rosenbrock23 {
         *k2 -= &*k1;
         ok &= w.solve_mut(k2);
         *k2 += &*k1;
-        y_new.copy_from(y);
-        y_new.axpy(h, k2, 1.0);
+        for i in 0..y.len() {
+            dy[i] = h * k2[i];
+            y_new[i] = y[i] + dy[i];
+        }
         ev.rhs(t_new, y_new, f2)?;
         for i in 0..y.len() {
             k3[i] = f2[i] - E32 * (k2[i] - f1[i]) - 2.0 * (k1[i] - f0[i]) + hd * tder[i];

@@ -18,6 +18,9 @@ pub struct Stats {
     pub lu_decompositions: u64,
     /// Newton iterations (implicit methods).
     pub newton_iters: u64,
+    /// Accepted steps on which a tolerance was below the f64 resolution of the state and was
+    /// raised to the floor `κ·ε·|y_i|` ([`TOL_FLOOR_KAPPA`](super::TOL_FLOOR_KAPPA)).
+    pub floored_steps: u64,
 }
 
 impl fmt::Display for Stats {

@@ -20,6 +20,15 @@ pub trait OdeSystem {
         false
     }
 
+    /// The period `P` of component `i` if `f` is periodic in it (`f(t, y + P e_i) = f(t, y)`
+    /// for every `y`, e.g. an angle on which the right-hand side depends only through sin and
+    /// cos). The solvers then carry that component as whole periods plus a remainder in
+    /// `[0, P)` and evaluate `f` at the remainder, which keeps its precision however far the
+    /// angle grows (see `turns.rs`); the output is the full value. Default: none.
+    fn period(&self, _i: usize) -> Option<f64> {
+        None
+    }
+
     /// `true` if `f` does not depend on `t` explicitly (lets the Rosenbrock method skip `∂f/∂t`).
     fn is_autonomous(&self) -> bool {
         false

@@ -132,8 +132,9 @@ impl AdaptiveStepper for TrBdf2 {
         step: &Step,
         y: &DVector<f64>,
         y_new: &mut DVector<f64>,
+        dy: &mut DVector<f64>,
     ) -> Result<Attempt, SolverError> {
-        let Step { t, h, t_new } = *step;
+        let Step { t, h, t_new, h_req } = *step;
         if self.refresh_jac {
             ev.jacobian(t, y, Some(&self.fn_), &mut self.jac)?;
             self.current_jac = true;
@@ -141,9 +142,12 @@ impl AdaptiveStepper for TrBdf2 {
         }
         let n = y.len();
         let dh = D * h;
-        if self.lu.as_ref().is_none_or(|(c, _)| *c != dh) {
+        // the factorisation is kept while the requested step is unchanged (the exact step
+        // differs from it by the rounding of t + h; simplified Newton does not mind)
+        let dh_req = D * h_req;
+        if self.lu.as_ref().is_none_or(|(c, _)| *c != dh_req) {
             ev.stats.lu_decompositions += 1;
-            self.lu = iteration_matrix(&self.jac, dh).map(|m| (dh, m));
+            self.lu = iteration_matrix(&self.jac, dh_req).map(|m| (dh_req, m));
         }
         let Self {
             newton,
@@ -157,23 +161,28 @@ impl AdaptiveStepper for TrBdf2 {
         weights.fill_scale(scale, y);
         let mut iters = None;
         if let Some((_, wm)) = self.lu.as_ref() {
+            // in increment form (Newton's unknowns and `base` relative to y_n, see
+            // `Newton::solve`), so that the step's increment keeps its own precision
             // TR stage, predictor: explicit Euler
-            base.copy_from(y);
-            base.axpy(dh, fn_, 1.0);
-            zg.copy_from(y);
-            zg.axpy(GAMMA * h, fn_, 1.0);
-            let o1 = newton.solve(ev, wm, t + GAMMA * h, base, dh, zg, scale)?;
+            for i in 0..n {
+                base[i] = dh * fn_[i];
+                zg[i] = GAMMA * h * fn_[i];
+            }
+            let o1 = newton.solve(ev, wm, t + GAMMA * h, base, dh, y, zg, scale)?;
             if o1.converged {
                 for i in 0..n {
                     fg[i] = (zg[i] - base[i]) / dh;
                 }
                 // BDF2 stage, predictor: quadratic through (y_n, f_n) and z_γ
                 for i in 0..n {
-                    base[i] = y[i] + h * W * (fn_[i] + fg[i]);
-                    let c2 = (zg[i] - y[i] - GAMMA * h * fn_[i]) / (GAMMA * GAMMA);
-                    y_new[i] = y[i] + h * fn_[i] + c2;
+                    base[i] = h * W * (fn_[i] + fg[i]);
+                    let c2 = (zg[i] - GAMMA * h * fn_[i]) / (GAMMA * GAMMA);
+                    dy[i] = h * fn_[i] + c2;
                 }
-                let o2 = newton.solve(ev, wm, t_new, base, dh, y_new, scale)?;
+                let o2 = newton.solve(ev, wm, t_new, base, dh, y, dy, scale)?;
+                for i in 0..n {
+                    y_new[i] = y[i] + dy[i];
+                }
                 iters = o2.converged.then_some(o1.iters.max(o2.iters));
             }
         }
@@ -189,7 +198,7 @@ impl AdaptiveStepper for TrBdf2 {
         };
         self.iters = iters;
         for i in 0..n {
-            self.f_new[i] = (y_new[i] - self.base[i]) / dh;
+            self.f_new[i] = (dy[i] - self.base[i]) / dh;
             self.est[i] = h * (E[0] * self.fn_[i] + E[1] * self.fg[i] + E[2] * self.f_new[i]);
         }
         let (est, scale) = (&mut self.est, &mut self.scale);
