@@ -20,7 +20,8 @@ pub struct TetMesh {
 impl TetMesh {
     /// Builds and validates a mesh: at least one element, node indices in range, finite coordinates,
     /// ten distinct nodes per element, four non-coincident corners, every node used, and every midside
-    /// node closest to the midpoint of its own edge (catches a wrong node order, e.g. gmsh's).
+    /// node where it fits its own edge better than any exchange with another edge's node would (catches a
+    /// wrong node order, e.g. gmsh's, and lets a curved element's node bulge onto a fillet).
     pub fn new(nodes: Vec<[f64; 3]>, elements: Vec<[usize; 10]>) -> Result<Self> {
         if elements.is_empty() {
             return Err(FemError::InvalidMesh("no elements".into()));
@@ -172,7 +173,14 @@ fn check_midside(x: &ElementCoords, e: usize, el: &[usize; 10]) -> Result<()> {
                 el[a], el[b]
             )));
         }
-        if (0..6).any(|m| m != k && dist(x[4 + k], mids[m]) < own) {
+        // a wrong node order swaps midside nodes between edges (gmsh's order differs from VTK's
+        // by the swap of the last two): flagged when exchanging this node with another edge's
+        // would fit both edges better. A curved element's midside node may sit nearer another
+        // edge's midpoint on a tight fillet without any swap fitting better.
+        if (0..6).any(|m| {
+            m != k
+                && dist(x[4 + k], mids[m]) + dist(x[4 + m], mids[k]) < own + dist(x[4 + m], mids[m])
+        }) {
             return Err(FemError::MidsideNodeOrder {
                 element: e,
                 local: 4 + k,
