@@ -36,7 +36,7 @@
 use std::collections::HashMap;
 use std::path::Path;
 
-use super::volume::RawVolume;
+use super::raw_volume::RawVolume;
 use crate::fem::error::{FemError, Result};
 
 /// Keywords carrying mesh data that are not read natively.

@@ -13,6 +13,7 @@
 pub mod gmsh;
 pub mod inp;
 pub mod msh;
+pub mod raw_volume;
 pub mod rod_mesher;
 pub mod rodmesh;
 pub mod size_field;

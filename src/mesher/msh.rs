@@ -25,7 +25,7 @@ use std::path::Path;
 
 use mshio::mshfile::ElementType;
 
-use super::volume::RawVolume;
+use super::raw_volume::RawVolume;
 use crate::fem::error::{FemError, Result};
 
 /// gmsh's 10-node tetrahedron → VTK's: swap the midside nodes 8 and 9.

@@ -1,143 +1,15 @@
 //! A user's volume mesh (`fem --mesh FILE`, `cycle --mesh FILE`) into a [`TetMesh`]: gmsh MSH 4.1
 //! ([`super::msh`]) and Abaqus/CalculiX `.inp` ([`super::inp`]) are read natively, in this
-//! process; everything else (VTU, Nastran `.bdf`/`.nas`, gmsh MSH 2.2 and 4.0) goes through meshio
+//! process ([`super::raw_volume`] finishes what they read as meshio's path would); everything
+//! else (VTU, Nastran `.bdf`/`.nas`, gmsh MSH 2.2 and 4.0) goes through meshio
 //! (`pipeline/mesh_rod.py convert`, [`super::gmsh::convert_mesh`]).
-//!
-//! The native readers give the mesh the meshio path gives, node for node and bit for bit
-//! (`tests/mesh_readers.rs`): [`RawVolume::finish`] repeats what `mesh_rod.py convert` does after
-//! meshio has read a file:
-//!
-//! * only tetrahedra are kept: 10-node ones (VTK tetra10 order: corners 0-3, then the midside
-//!   nodes of edges 01, 12, 02, 03, 13, 23) as they are, in file order; 4-node ones are promoted to
-//!   straight-sided tet10 (one new node per distinct edge at its midpoint, the new nodes numbered
-//!   after the file's in the lexicographic order of their sorted corner pairs, as numpy's
-//!   `unique(axis=0)` numbers them); a file with both kinds, or with none, is refused; surface,
-//!   line and point elements are dropped;
-//! * nodes no tetrahedron uses are dropped, the others keep their file order;
-//! * the coordinates are the file's numbers times the unit (mm: × 1e-3, m: × 1), so that the
-//!   mesh is in metres.
 
 use std::path::Path;
 
 use super::gmsh::convert_mesh;
+use super::raw_volume::unit_scale;
 use crate::fem::TetMesh;
 use crate::fem::error::{FemError, Result};
-
-/// Tetrahedra of a file as read, before [`RawVolume::finish`]: coordinates in the file's
-/// numbers, 0-based indices into `nodes` (file order).
-#[derive(Clone, Debug, Default)]
-pub struct RawVolume {
-    /// Node coordinates as written in the file (file order).
-    pub nodes: Vec<[f64; 3]>,
-    /// 10-node tetrahedra, VTK order, file order.
-    pub tet10: Vec<[usize; 10]>,
-    /// 4-node tetrahedra, file order.
-    pub tet4: Vec<[usize; 4]>,
-    /// Kinds of elements dropped (surface, line, point elements), for messages.
-    pub dropped: Vec<String>,
-}
-
-/// VTK tetra10 edges, in the order of the midside nodes 4..9 (the same table as `mesh_rod.py`).
-const TET10_EDGES: [(usize, usize); 6] = [(0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3)];
-
-/// The factor from the file's numbers to metres: "mm" → 1e-3, "m" → 1.
-pub fn unit_scale(units: &str) -> Result<f64> {
-    match units {
-        "mm" => Ok(1e-3),
-        "m" => Ok(1.0),
-        _ => Err(FemError::InvalidInput(format!(
-            "mesh units must be mm or m, got {units}"
-        ))),
-    }
-}
-
-impl RawVolume {
-    /// The mesh in metres (`scale` from [`unit_scale`]), as `mesh_rod.py convert` makes it (see
-    /// the module documentation); `path` names the file in errors.
-    pub fn finish(self, path: &Path, scale: f64) -> Result<TetMesh> {
-        let whole = |message: String| FemError::Parse {
-            path: path.to_path_buf(),
-            line: 0,
-            message,
-        };
-        let RawVolume {
-            mut nodes,
-            tet10,
-            tet4,
-            dropped,
-        } = self;
-        let tets: Vec<[usize; 10]> = match (tet10.is_empty(), tet4.is_empty()) {
-            (false, false) => {
-                return Err(whole(
-                    "mixes 4-node and 10-node tetrahedra; give one kind".into(),
-                ));
-            }
-            (true, true) => {
-                let mut kinds = dropped;
-                kinds.sort();
-                kinds.dedup();
-                return Err(whole(format!(
-                    "has no tetrahedra (element types: {})",
-                    if kinds.is_empty() {
-                        "none".to_string()
-                    } else {
-                        kinds.join(", ")
-                    }
-                )));
-            }
-            (false, true) => tet10,
-            (true, false) => promote_tet4(&mut nodes, &tet4),
-        };
-        // keep the nodes the tets use, renumbered in their file order
-        let mut remap = vec![usize::MAX; nodes.len()];
-        for el in &tets {
-            for &n in el {
-                remap[n] = 0;
-            }
-        }
-        let mut kept = Vec::with_capacity(nodes.len());
-        for (i, r) in remap.iter_mut().enumerate() {
-            if *r == 0 {
-                *r = kept.len();
-                let p = nodes[i];
-                kept.push([p[0] * scale, p[1] * scale, p[2] * scale]);
-            }
-        }
-        let elements = tets.into_iter().map(|el| el.map(|n| remap[n])).collect();
-        TetMesh::new(kept, elements).map_err(|e| whole(e.to_string()))
-    }
-}
-
-/// Linear tets → straight-sided tet10 exactly as `mesh_rod.py`'s `promote_tetra4` (numpy): the
-/// new nodes are appended in the lexicographic order of the sorted edges, at 0.5 (a + b).
-fn promote_tet4(nodes: &mut Vec<[f64; 3]>, tets: &[[usize; 4]]) -> Vec<[usize; 10]> {
-    let key = |el: &[usize; 4], k: usize| {
-        let (a, b) = TET10_EDGES[k];
-        let (a, b) = (el[a], el[b]);
-        (a.min(b), a.max(b))
-    };
-    let mut edges: Vec<(usize, usize)> = tets
-        .iter()
-        .flat_map(|el| (0..6).map(move |k| key(el, k)))
-        .collect();
-    edges.sort_unstable();
-    edges.dedup();
-    let n0 = nodes.len();
-    for &(a, b) in &edges {
-        let (pa, pb) = (nodes[a], nodes[b]);
-        nodes.push(std::array::from_fn(|j| 0.5 * (pa[j] + pb[j])));
-    }
-    tets.iter()
-        .map(|el| {
-            let mut t = [0usize; 10];
-            t[..4].copy_from_slice(el);
-            for k in 0..6 {
-                t[4 + k] = n0 + edges.binary_search(&key(el, k)).expect("edge listed");
-            }
-            t
-        })
-        .collect()
-}
 
 /// How a volume mesh file is read.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
