@@ -122,8 +122,10 @@ struct Setup {
 const FRAME: &str = "rod frame, mm: origin at the crank pin A, x along A→B, z along the pin axis";
 
 impl Setup {
-    fn new(design: &LoadedDesign, config: &StudyConfig) -> Self {
-        let surface = rod_frame_surface(design);
+    /// `for_gmsh`: the surface is what gmsh will mesh (simplified); else a given mesh is solved
+    /// and the surface only tells the sharp re-entrant edges.
+    fn new(design: &LoadedDesign, config: &StudyConfig, for_gmsh: bool) -> Self {
+        let surface = rod_frame_surface(design, for_gmsh);
         let singular_edges: Vec<[[f64; 3]; 2]> =
             reentrant_edges(&surface.vertices, &surface.triangles, FEATURE_ANGLE_DEG)
                 .into_iter()
@@ -231,7 +233,7 @@ pub fn fem_fixed(
     work_dir: &Path,
     size_mm: f64,
 ) -> Result<FemOutcome> {
-    let setup = Setup::new(design, config);
+    let setup = Setup::new(design, config, true);
     let mut mesher = setup.mesher(work_dir)?;
     let meshed = mesher
         .fixed(size_mm)
@@ -269,7 +271,7 @@ pub fn fem_adaptive(
     work_dir: &Path,
     settings: &AdaptiveMeshing,
 ) -> Result<FemOutcome> {
-    let setup = Setup::new(design, config);
+    let setup = Setup::new(design, config, true);
     let mut mesher = setup.mesher(work_dir)?;
     let facets = FacetScale::new(
         &setup.surface.vertices,
@@ -355,7 +357,7 @@ pub fn fem_user_mesh(
             let start = std::time::Instant::now();
             read_volume_mesh(file, "mm", work_dir).map(|(m, _)| (m, start.elapsed()))
         });
-        let setup = Setup::new(design, config);
+        let setup = Setup::new(design, config, false);
         let read = reading
             .join()
             .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
@@ -403,7 +405,7 @@ pub fn fem_refinement(
     sizes_mm: &[f64],
 ) -> Result<RefinementStudy> {
     // meshed in the rod frame, mm, as stage 3 meshes (any units and pose)
-    let setup = Setup::new(design, config);
+    let setup = Setup::new(design, config, true);
     let mesher = setup.mesher(work_dir)?;
     Ok(refinement_study(
         sizes_mm,

@@ -48,8 +48,10 @@ impl RodFrameSurface {
     }
 }
 
-/// The validated surface of a loaded design in the rod frame, mm, simplified.
-pub fn rod_frame_surface(d: &LoadedDesign) -> RodFrameSurface {
+/// The validated surface of a loaded design in the rod frame, mm; simplified for gmsh when
+/// `simplified` (a given mesh needs the surface only for its sharp re-entrant edges: the export as
+/// it is, without the simplification's cost).
+pub fn rod_frame_surface(d: &LoadedDesign, simplified: bool) -> RodFrameSurface {
     use sha2::Digest;
     let f = &d.frame;
     let mut mesh = d.mesh.clone();
@@ -60,10 +62,14 @@ pub fn rod_frame_surface(d: &LoadedDesign) -> RodFrameSurface {
     // what gmsh reads must not grow with the export's triangle count: flat facets cut into many
     // triangles merge back (zero error), curved ones stay within SIMPLIFY_TOLERANCE_MM
     let before = mesh.triangles.len();
-    let (simplified, report) = simplify(&mesh, SIMPLIFY_TOLERANCE_MM);
-    let mesh = match validate(simplified) {
-        Ok(v) if v.warnings.is_empty() => v.mesh,
-        _ => mesh,
+    let (mesh, max_error) = if simplified {
+        let (simpler, report) = simplify(&mesh, SIMPLIFY_TOLERANCE_MM);
+        match validate(simpler) {
+            Ok(v) if v.warnings.is_empty() => (v.mesh, report.max_error),
+            _ => (mesh, report.max_error),
+        }
+    } else {
+        (mesh, 0.0)
     };
     let bytes = binary_stl(&to_soup(&mesh));
     RodFrameSurface {
@@ -78,6 +84,6 @@ pub fn rod_frame_surface(d: &LoadedDesign) -> RodFrameSurface {
         frame: *f,
         to_metres: d.settings.units.to_metres(),
         triangles_export: before,
-        simplify_max_error_mm: report.max_error,
+        simplify_max_error_mm: max_error,
     }
 }
