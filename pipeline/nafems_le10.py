@@ -135,7 +135,7 @@ def write(path: pathlib.Path, xyz, tets):
             if all(top[row[c]] for c in f):
                 out.append(f"{e + 1}, P{k + 1}, {P:.13g}")
                 loaded += 1
-    out += ["*NODE PRINT, NSET=D", "U", "*NODE FILE", "U", "*EL FILE", "S", "*END STEP"]
+    out += ["*NODE PRINT, NSET=D", "U, S, RF", "*NODE FILE", "U", "*EL FILE", "S", "*END STEP"]
     path.write_text("\n".join(out) + "\n")
     return int(d[0] + 1), loaded, {k: len(v) for k, v in sets.items()}
 
