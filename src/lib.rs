@@ -22,6 +22,8 @@
 //! - [`study`]: running the stages over every design of a folder (cache, shards, merge, baseline);
 //! - [`report`]: everything that writes: tables, ranking, Pareto front, index page, plots, VTU
 //!   field files, stress pictures;
+//! - [`deck`]: `rodstudy solve`: linear static analysis of a CalculiX/Abaqus input deck (the
+//!   subset a tet model needs), for the field's benchmarks (NAFEMS LE10) and users' models;
 //! - [`mesher`]: the gmsh adapter (the Python mesher as a subprocess, the hand-off files), behind
 //!   the small trait the adaptive loop calls;
 //! - [`config`]: the study's settings (`rodstudy.toml`);
@@ -32,6 +34,7 @@
 pub mod bench;
 pub mod cli;
 pub mod config;
+pub mod deck;
 pub mod fem;
 pub mod free_run;
 pub mod geometry;

@@ -13,6 +13,7 @@ mod mass;
 mod merge;
 mod mesh_args;
 mod pipeline;
+mod solve;
 mod study;
 mod sweep;
 
@@ -60,6 +61,8 @@ enum Command {
     /// Parameter sweeps: generate rods from a Latin-hypercube sample of the design parameters.
     #[command(subcommand)]
     Sweep(sweep::SweepCommand),
+    /// Linear static analysis of a CalculiX/Abaqus input deck (C3D10/C3D4; NAFEMS LE10 and users' models).
+    Solve(solve::SolveArgs),
 }
 
 /// Parses the command line, runs the command, prints errors; returns the exit status.
@@ -84,6 +87,7 @@ pub fn main() -> i32 {
         Command::Setup => pipeline::setup(),
         Command::Pipeline(args) => pipeline::run(args),
         Command::Sweep(command) => sweep::run(command),
+        Command::Solve(args) => solve::run(args),
     };
     match result {
         Ok(code) => code,

@@ -36,6 +36,7 @@ pub mod fatigue;
 pub mod load;
 pub mod material;
 pub mod mesh;
+pub mod nodal_stress;
 pub mod quadrature;
 pub mod recovery;
 pub mod refinement;

@@ -1,0 +1,43 @@
+//! Linear static analysis of a standard input deck: the subset of the Abaqus/CalculiX `.inp`
+//! format a linear static model of tetrahedra needs (`rodstudy solve DECK.inp`), so that the FEM
+//! core can be run on the field's benchmarks (NAFEMS LE10: NAFEMS, "The Standard NAFEMS
+//! Benchmarks", TNSB Rev. 3, 1990; `pipeline/nafems_le10.py`) and on a user's own CalculiX or
+//! Abaqus model.
+//!
+//! * [`parse`]: lines into cards (keyword, parameters, data lines, line numbers);
+//! * [`model`]: cards into the model (nodes, C3D10/C3D4 elements, sets, material, section,
+//!   supports, loads, output requests per step); every other keyword, parameter or data form is
+//!   refused with its line number, never ignored;
+//! * [`solve`]: the model to [`crate::fem::StaticProblem`] and back (node-set values, reactions,
+//!   nodal stresses formed as CalculiX forms them, [`crate::fem::nodal_stress`]);
+//! * [`output`]: the JSON document and the VTU files.
+//!
+//! Reference for the format and its semantics: the CalculiX CrunchiX user's manual (ccx 2.20),
+//! "Input deck format" and the keyword sections; the element node order and face numbering from
+//! its "C3D10" section. Deck units are kept as given (no conversion).
+
+pub mod model;
+pub mod output;
+pub mod parse;
+pub mod solve;
+
+use std::path::Path;
+
+use crate::fem::error::{FemError, Result};
+pub use model::Model;
+pub use solve::{DeckSolution, SolveOptions, solve_model};
+
+/// Reads and checks the deck at `path`.
+pub fn read_deck(path: &Path) -> Result<Model> {
+    let text = std::fs::read_to_string(path).map_err(|e| FemError::Io {
+        path: path.to_path_buf(),
+        source: e,
+    })?;
+    read_deck_text(path, &text)
+}
+
+/// Reads a deck from `text` (`path` names it in errors).
+pub fn read_deck_text(path: &Path, text: &str) -> Result<Model> {
+    let cards = parse::cards(path, text)?;
+    Model::from_cards(path, &cards)
+}

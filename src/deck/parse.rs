@@ -1,0 +1,140 @@
+//! Lines of an Abaqus/CalculiX input deck into cards: a keyword line (`*KEYWORD, PARAM=VALUE, ...`)
+//! and its data lines, each with its 1-based line number.
+//!
+//! Syntax as in the CalculiX CrunchiX user's manual (ccx 2.20), "Input deck format": a line starting
+//! with `*` is a keyword line, `**` a comment line; keywords and parameter names are
+//! case-insensitive (upper-cased here), a keyword line ending with a comma continues on the next
+//! line; data fields are separated by commas, blanks around them are not significant, and empty
+//! trailing fields are dropped. Keywords of more than one word (`*SOLID SECTION`, `*NODE PRINT`)
+//! are kept with one blank between the words.
+
+use std::path::Path;
+
+use crate::fem::error::{FemError, Result};
+
+/// One data line: its line number and its comma-separated fields (trimmed).
+#[derive(Clone, Debug, PartialEq)]
+pub struct DataLine {
+    /// 1-based line number.
+    pub line: usize,
+    /// The fields, trimmed, trailing empty ones dropped.
+    pub fields: Vec<String>,
+}
+
+/// A keyword with its parameters and data lines.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Card {
+    /// Upper-cased keyword without the `*`, words separated by one blank.
+    pub keyword: String,
+    /// Parameters: upper-cased name and value as written (empty when the parameter has none).
+    pub params: Vec<(String, String)>,
+    /// 1-based line number of the keyword line.
+    pub line: usize,
+    /// The data lines that follow.
+    pub data: Vec<DataLine>,
+}
+
+impl Card {
+    /// The value of parameter `name` (upper case), if given.
+    pub fn param(&self, name: &str) -> Option<&str> {
+        self.params
+            .iter()
+            .find(|(k, _)| k == name)
+            .map(|(_, v)| v.as_str())
+    }
+
+    /// True when parameter `name` is given (with or without a value).
+    pub fn has(&self, name: &str) -> bool {
+        self.params.iter().any(|(k, _)| k == name)
+    }
+}
+
+/// A parse error at `line` of `path`.
+pub fn error(path: &Path, line: usize, message: impl Into<String>) -> FemError {
+    FemError::Parse {
+        path: path.to_path_buf(),
+        line,
+        message: message.into(),
+    }
+}
+
+/// Splits `text` into cards. Data lines before the first keyword are an error.
+pub fn cards(path: &Path, text: &str) -> Result<Vec<Card>> {
+    let mut out: Vec<Card> = Vec::new();
+    let mut continuing = false;
+    for (i, raw) in text.lines().enumerate() {
+        let ln = i + 1;
+        let t = raw.trim();
+        if t.is_empty() || t.starts_with("**") {
+            continue;
+        }
+        if continuing {
+            // continuation of the previous keyword line's parameters
+            continuing = t.ends_with(',');
+            let card = out.last_mut().expect("continuing a card");
+            card.params.extend(params(t));
+            continue;
+        }
+        if let Some(rest) = t.strip_prefix('*') {
+            continuing = rest.ends_with(',');
+            let mut parts = rest.splitn(2, ',');
+            let keyword = parts
+                .next()
+                .unwrap_or("")
+                .split_whitespace()
+                .collect::<Vec<_>>()
+                .join(" ")
+                .to_ascii_uppercase();
+            if keyword.is_empty() {
+                return Err(error(path, ln, "a keyword line without a keyword"));
+            }
+            out.push(Card {
+                keyword,
+                params: params(parts.next().unwrap_or("")),
+                line: ln,
+                data: Vec::new(),
+            });
+            continue;
+        }
+        let Some(card) = out.last_mut() else {
+            return Err(error(path, ln, "a data line before the first keyword"));
+        };
+        let mut fields: Vec<String> = t.split(',').map(|f| f.trim().to_string()).collect();
+        while fields.last().is_some_and(|f| f.is_empty()) {
+            fields.pop();
+        }
+        card.data.push(DataLine { line: ln, fields });
+    }
+    Ok(out)
+}
+
+fn params(s: &str) -> Vec<(String, String)> {
+    s.split(',')
+        .map(str::trim)
+        .filter(|p| !p.is_empty())
+        .map(|p| {
+            let (k, v) = p.split_once('=').unwrap_or((p, ""));
+            (k.trim().to_ascii_uppercase(), v.trim().to_string())
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn keywords_params_data_and_lines() {
+        let text = "** c\n*Node, nset=ALL\n1, 0, 0, 0\n\n*solid   section, elset=E,\n material=M\n*END STEP\n";
+        let c = cards(Path::new("x.inp"), text).unwrap();
+        assert_eq!(c.len(), 3);
+        assert_eq!(c[0].keyword, "NODE");
+        assert_eq!(c[0].param("NSET"), Some("ALL"));
+        assert_eq!(c[0].data[0].line, 3);
+        assert_eq!(c[0].data[0].fields, ["1", "0", "0", "0"]);
+        assert_eq!(c[1].keyword, "SOLID SECTION");
+        assert_eq!(c[1].line, 5);
+        assert_eq!(c[1].param("MATERIAL"), Some("M"));
+        assert_eq!(c[2].keyword, "END STEP");
+    }
+}
