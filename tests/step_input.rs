@@ -370,8 +370,16 @@ fn curved_tet10_on_the_step_fillet_rod() {
             .as_f64()
             .unwrap()
     };
-    // the reference's own extrapolation (see the file's "what"): F_y 385.58, F_x 21.38 MPa
-    let (ref_fy, ref_fx) = (385.58, 0.5 * (last("fx") + data["fx"][1].as_f64().unwrap()));
+    // the reference's own extrapolation (see the file's "what"): F_y 385.58 MPa with the observed
+    // order 4.0; with the theoretical order 2 of quadratic elements the same three values give
+    // 385.43 + 0.47 / (1.4² − 1) = 385.92 MPa. That 0.09 % is the reference's own uncertainty:
+    // the true error is taken as the distance to the reference less it (F_x: the mean of the last
+    // two, ± half their difference, as the file says)
+    let fy1 = data["fy"][1].as_f64().unwrap();
+    let fy_q2 = last("fy") + (last("fy") - fy1) / (1.4f64.powi(2) - 1.0);
+    let fx1 = data["fx"][1].as_f64().unwrap();
+    let (ref_fy, ref_fx) = (385.58, 0.5 * (last("fx") + fx1));
+    let (unc_fy, unc_fx) = ((fy_q2 - ref_fy).abs(), 0.5 * (last("fx") - fx1).abs());
     let config = StudyConfig::default();
     let design = stages::mass::load(&step).unwrap();
     let r = stages::fem::fem(
@@ -384,10 +392,15 @@ fn curved_tet10_on_the_step_fillet_rod() {
     .unwrap()
     .record;
     assert!(r.mesh.source.contains("STEP"), "{}", r.mesh.source);
-    for (case, c, reference) in [("fy", &r.fem.fy, ref_fy), ("fx", &r.fem.fx, ref_fx)] {
-        let truth = (c.max_von_mises_away_from_fixed_mpa / reference - 1.0).abs();
+    for (case, c, reference, uncertainty) in [
+        ("fy", &r.fem.fy, ref_fy, unc_fy),
+        ("fx", &r.fem.fx, ref_fx, unc_fx),
+    ] {
+        let truth = ((c.max_von_mises_away_from_fixed_mpa - reference).abs() - uncertainty)
+            .max(0.0)
+            / reference;
         println!(
-            "STEP {case}: {:.2} MPa ± {:.2} %, reference {reference:.2}: true {:.2} %, ratio {:.2}",
+            "STEP {case}: {:.2} MPa ± {:.2} %, reference {reference:.2} ± {uncertainty:.2}: true {:.2} %, ratio {:.2}",
             c.max_von_mises_away_from_fixed_mpa,
             100.0 * c.estimated_error_rel,
             100.0 * truth,

@@ -136,7 +136,11 @@ pub fn bench_fem_mesh(
     let design = design?;
     phase("load the design (STL, sidecar, validation)", t, true);
     let (t, _) = median_time(repeats, || rod_frame_surface(&design, true));
-    phase("rod-frame surface simplified to 5 µm for gmsh (not on the --mesh path)", t, false);
+    phase(
+        "rod-frame surface simplified to 5 µm for gmsh (not on the --mesh path)",
+        t,
+        false,
+    );
     let (t, surface) = median_time(repeats, || rod_frame_surface(&design, false));
     phase("rod-frame surface as exported (what --mesh uses)", t, true);
     let (t, singular) = median_time(repeats, || {
