@@ -11,10 +11,11 @@
 use std::path::{Path, PathBuf};
 
 use rodstudy::fem::boundary::boundary_faces;
-use rodstudy::fem::buckling::{BucklingOptions, BucklingProblem, solve_buckling};
+use rodstudy::fem::buckling::{BucklingOptions, BucklingProblem, rod_buckling, solve_buckling};
 use rodstudy::fem::load::uniform_traction_with_resultant;
 use rodstudy::fem::mesh::structured::box_tet10;
 use rodstudy::fem::*;
+use rodstudy::mesher::{mesh_stl, write_rodmesh};
 
 /// Column [0, L] × [0, b] × [0, b], fixed (all DOFs) on x = 0, a uniform traction of resultant
 /// `force` (N, along x) on the face x = L.
@@ -110,5 +111,71 @@ fn tensile_load_is_refused() {
     assert!(
         err.contains("no positive buckling load factor") && err.contains("tensile"),
         "{err}"
+    );
+}
+
+/// needs Python (gmsh) and CalculiX `ccx`: design 1 meshed at 8 mm (rod frame: A at the origin, B
+/// at x = 180 mm, pins along z), F_x = 7500 N on bore A towards the fixed bore B.
+#[test]
+fn design1_against_calculix_buckle() {
+    // reference: CalculiX 2.x `*BUCKLE` (C3D10, Lanczos) on the identical mesh, supports and
+    // consistent nodal forces (pipeline/ccx_peer.py --buckle)
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let py: PathBuf = rodstudy::python_env::python().expect("the pipeline's Python environment");
+    let dir = tempfile::tempdir().unwrap();
+    let meshed = mesh_stl(
+        &py,
+        &root.join("pipeline/mesh_rod.py"),
+        &root.join("designs/design1.stl"),
+        8.0,
+        dir.path(),
+    )
+    .unwrap();
+    let force = 7500.0;
+    let ours = rod_buckling(
+        &meshed.mesh,
+        &Material::STEEL,
+        &BoreSpec::default(),
+        force,
+        QuadratureChoice::Auto,
+        &BucklingOptions::default(),
+    )
+    .unwrap();
+    let file = dir.path().join("design1_8mm.rodmesh");
+    write_rodmesh(&meshed.mesh, &file).unwrap();
+    let out = std::process::Command::new(&py)
+        .arg(root.join("pipeline/ccx_peer.py"))
+        .arg(&file)
+        .args(["--buckle", "--json", "--force", "7500"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "ccx_peer.py --buckle: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let peer: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let ccx = peer["buckling_factor"].as_f64().unwrap();
+    let rel = (ours.load_factor - ccx) / ccx;
+    eprintln!(
+        "design 1 at 8 mm ({} elements, {} equations): ours λ₁ = {:.5} ({} iterations, residual {:.1e}, \
+         static {:.2} s, K_σ {:.2} s, iteration {:.2} s; Ritz {:?}), ccx {ccx:.5} ({:.2} s): {:+.3} %",
+        meshed.mesh.n_elements(),
+        ours.equations,
+        ours.load_factor,
+        ours.iterations,
+        ours.residual_rel,
+        ours.static_s,
+        ours.geometric_s,
+        ours.iteration_s,
+        ours.ritz_load_factors,
+        peer["ccx_wall_s"].as_f64().unwrap(),
+        100.0 * rel
+    );
+    assert!(ours.load_factor > 1.0, "a rod does not buckle under 7.5 kN");
+    assert!(
+        rel.abs() < 0.01,
+        "ours {} against ccx {ccx}",
+        ours.load_factor
     );
 }
