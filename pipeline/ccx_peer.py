@@ -2,6 +2,7 @@
 """Independent peer of rodstudy's FEM stage: the same rod model solved by CalculiX (ccx).
 
   ccx_peer.py MESH.rodmesh [--force 7500] [--ours RESULT.json] [--workdir DIR] [--ccx ccx]
+  ccx_peer.py MESH.rodmesh --buckle [--force 7500] [--json]
 
 Reads the very mesh the Rust solver used (the .rodmesh hand-off file, VTK tetra10 order, which is
 also CalculiX's C3D10 order), and builds the same model independently, with numpy:
@@ -17,6 +18,11 @@ Runs ccx (SPOOLES, OMP_NUM_THREADS=2 unless set), reads the nodal stresses from 
 extrapolates the integration-point stresses to the nodes and averages them over the elements),
 computes von Mises of the averaged tensors and prints its maxima, max displacement and wall time.
 With --ours (the JSON of rodstudy's FemResult for the same mesh) it prints ours beside them.
+
+With --buckle: linear buckling instead (CalculiX *BUCKLE, one buckling factor, accuracy 1e-8)
+of the F_x case alone: the same supports, the same consistent nodal forces of the resultant F
+along +x (A towards the fixed B: compression) as *CLOAD; prints the factor read from the .dat
+("B U C K L I N G   F A C T O R   O U T P U T"); the buckling load is factor × F.
 
 Exit status 0; a missing ccx is reported (exit 2).
 """
@@ -143,6 +149,35 @@ def write_deck(path, pts, tets, fixed_nodes, loads, e_mpa, nu):
     path.write_text("\n".join(out) + "\n")
 
 
+def write_buckle_deck(path, pts, tets, fixed_nodes, load, e_mpa, nu, accuracy=1e-8):
+    """The deck of write_deck with one *BUCKLE step of `load` (1 factor, Lanczos accuracy)."""
+    write_deck(path, pts, tets, fixed_nodes, [], e_mpa, nu)
+    out = ["*STEP", "*BUCKLE", f"1, {accuracy:g}", "*CLOAD"]
+    for n in np.nonzero(np.abs(load).sum(axis=1))[0]:
+        for j in range(3):
+            if load[n, j] != 0.0:
+                out.append(f"{n + 1}, {j + 1}, {load[n, j]:.13g}")
+    out += ["*NODE FILE", "U", "*END STEP"]
+    with path.open("a") as f:
+        f.write("\n".join(out) + "\n")
+
+
+def read_buckling_factors(path: pathlib.Path):
+    """The buckling factors of a .dat ("MODE NO  BUCKLING FACTOR" table)."""
+    factors, inside = [], False
+    for line in path.read_text().splitlines():
+        if "B U C K L I N G" in line:
+            inside = True
+            continue
+        if inside:
+            parts = line.split()
+            if len(parts) == 2 and parts[0].isdigit():
+                factors.append(float(parts[1]))
+            elif factors and not parts:
+                break
+    return factors
+
+
 def read_frd(path: pathlib.Path, n_nodes: int):
     """Blocks DISP and STRESS per step from an ASCII .frd, as arrays indexed by node."""
     steps = []
@@ -177,6 +212,8 @@ def main(argv=None) -> int:
     ap.add_argument("--workdir", help="keep the deck and results here (default: a temporary folder)")
     ap.add_argument("--ccx", default="ccx")
     ap.add_argument("--json", action="store_true", help="print the figures as one JSON line")
+    ap.add_argument("--buckle", action="store_true",
+                    help="linear buckling (*BUCKLE) of the F_x case instead of the static cases")
     args = ap.parse_args(argv)
     ccx = shutil.which(args.ccx)
     if not ccx:
@@ -187,6 +224,8 @@ def main(argv=None) -> int:
     bore_a, ra = find_bore(pts, faces, (0, 0, 0), (0, 0, 1), "bore A")
     bore_b, rb = find_bore(pts, faces, (180, 0, 0), (0, 0, 1), "bore B")
     fixed = np.unique(bore_b)
+    if args.buckle:
+        return buckle(args, ccx, pts, tets, bore_a, bore_b, ra, rb, fixed)
     loads = []
     for d in ([1.0, 0, 0], [0, 1.0, 0]):
         f, area = consistent_forces(pts, bore_a, np.array(d) * args.force)
@@ -238,6 +277,36 @@ def main(argv=None) -> int:
         t += f"; ours {ours_s:.2f} s (assembly {tt['assembly_s']:.2f}, factorisation {tt['symbolic_s'] + tt['factorisation_s']:.2f}, " \
              f"solve {tt['solve_s']:.2f}, stress {tt['stress_s']:.2f})"
     print(t)
+    if not args.workdir:
+        shutil.rmtree(work, ignore_errors=True)
+    return 0
+
+
+def buckle(args, ccx, pts, tets, bore_a, bore_b, ra, rb, fixed) -> int:
+    f, area = consistent_forces(pts, bore_a, np.array([1.0, 0.0, 0.0]) * args.force)
+    work = pathlib.Path(args.workdir) if args.workdir else pathlib.Path(tempfile.mkdtemp(prefix="ccx_buckle_"))
+    work.mkdir(parents=True, exist_ok=True)
+    write_buckle_deck(work / "rod.inp", pts, tets, fixed, f, 210000.0, 0.3)
+    env = dict(os.environ)
+    env.setdefault("OMP_NUM_THREADS", "2")
+    env.setdefault("CCX_NPROC_EQUATION_SOLVER", env["OMP_NUM_THREADS"])
+    t0 = time.perf_counter()
+    run = subprocess.run([ccx, "-i", "rod"], cwd=work, env=env, capture_output=True, text=True)
+    wall = time.perf_counter() - t0
+    factors = read_buckling_factors(work / "rod.dat") if (work / "rod.dat").exists() else []
+    if run.returncode != 0 or not factors:
+        print(run.stdout[-3000:], run.stderr[-3000:], file=sys.stderr)
+        return 1
+    figures = {"ccx_wall_s": wall, "nodes": len(pts), "elements": len(tets), "force_n": args.force,
+               "bore_a_radius_mm": ra, "bore_b_radius_mm": rb, "loaded_faces": len(bore_a),
+               "fixed_nodes": len(fixed), "loaded_area_mm2": area, "buckling_factors": factors,
+               "buckling_factor": factors[0], "buckling_load_n": factors[0] * args.force}
+    if args.json:
+        print(json.dumps(figures))
+    else:
+        print(f"mesh {args.mesh}: {len(pts)} nodes, {len(tets)} C3D10; F_x = {args.force} N on bore A "
+              f"(r = {ra:.3f} mm), bore B fixed (r = {rb:.3f} mm): ccx *BUCKLE factor {factors[0]:.6g}, "
+              f"buckling load {factors[0] * args.force:.6g} N ({wall:.2f} s)")
     if not args.workdir:
         shutil.rmtree(work, ignore_errors=True)
     return 0

@@ -28,6 +28,8 @@
 //! with_error = false  # judge the peak plus its estimated error instead of the peak
 //! fatigue = true      # the criterion includes the cycle's fatigue safety factor …
 //! fatigue_safety_factor = 1.5   # … which must be at least this
+//! buckling_factor = 3.0         # the smallest accepted linear buckling load factor, judged
+//!                               # when buckling is computed (in the study: with a pressure trace)
 //!
 //! [cycle]             # stress over one revolution (inertia relief, fatigue)
 //! enabled = true
@@ -138,6 +140,20 @@ pub struct CriterionConfig {
     pub fatigue: bool,
     /// The smallest accepted Goodman safety factor.
     pub fatigue_safety_factor: f64,
+    /// The smallest accepted linear buckling load factor λ₁ (buckling load / peak compression),
+    /// judged where buckling is computed (the study: with `[engine] pressure_trace`). Written
+    /// only when not the default, so default results keep their bytes.
+    #[serde(skip_serializing_if = "CriterionConfig::is_default_buckling_factor")]
+    pub buckling_factor: f64,
+}
+
+impl CriterionConfig {
+    /// The default smallest accepted buckling load factor.
+    pub const DEFAULT_BUCKLING_FACTOR: f64 = 3.0;
+
+    fn is_default_buckling_factor(v: &f64) -> bool {
+        *v == Self::DEFAULT_BUCKLING_FACTOR
+    }
 }
 
 impl Default for CriterionConfig {
@@ -148,6 +164,7 @@ impl Default for CriterionConfig {
             with_error: false,
             fatigue: true,
             fatigue_safety_factor: 1.5,
+            buckling_factor: CriterionConfig::DEFAULT_BUCKLING_FACTOR,
         }
     }
 }
@@ -430,6 +447,7 @@ impl StudyConfig {
                 "criterion.fatigue_safety_factor",
                 self.criterion.fatigue_safety_factor,
             ),
+            ("criterion.buckling_factor", self.criterion.buckling_factor),
             ("material.ultimate_mpa", self.material.ultimate_mpa),
             ("material.endurance_mpa", self.material.endurance_mpa),
         ];

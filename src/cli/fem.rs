@@ -106,6 +106,30 @@ pub fn run(args: FemArgs) -> Result<i32> {
         return Ok(0);
     }
     let mut outcome = stages::fem::fem(&design, force, &config, &args.out.join("mesh"), &mode)?;
+    // buckling, always: under --force if given, else the peak compression (with a pressure
+    // trace, where stage 3 has computed and judged it already) or the peak pin force (F_x)
+    if outcome.record.buckling_load_factor.is_none() || args.force.is_some() {
+        let load = match args.force {
+            Some(f) => f,
+            None => stages::fem::buckling_load(&design, &config)?,
+        };
+        match stages::fem::buckling(&outcome.mesh, &config, load) {
+            Ok(b) => {
+                outcome.record.buckling_load_factor = Some(b.load_factor);
+                outcome.solution.buckling = Some(crate::fem::buckling::BucklingMode {
+                    load_factor: b.load_factor,
+                    load_n: load,
+                    mode: b.mode,
+                });
+            }
+            Err(e) => {
+                outcome.record.buckling_load_factor = None;
+                outcome.solution.buckling = None;
+                eprintln!("buckling: {e:#}");
+            }
+        }
+    }
+    let buckling_load_n = outcome.solution.buckling.as_ref().map(|b| b.load_n);
     if args.no_pictures {
         crate::report::fields::write_fem_vtus(
             &mut outcome.record.fem,
@@ -125,9 +149,18 @@ pub fn run(args: FemArgs) -> Result<i32> {
     }
     let result = outcome.record;
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&FemJson::from(&result))?);
+        let mut json = FemJson::from(&result);
+        json.buckling_load_n = buckling_load_n;
+        println!("{}", serde_json::to_string_pretty(&json)?);
     } else {
         print_result(&result);
+        if let (Some(l), Some(load)) = (result.buckling_load_factor, buckling_load_n) {
+            println!(
+                "buckling: load factor {l:.3} under {load:.1} N of compression on the big-end bore (small-end bore fixed): linear buckling load {:.0} N; mode in {}",
+                l * load,
+                args.out.join("buckling_mode.vtu").display()
+            );
+        }
     }
     Ok(0)
 }
@@ -144,6 +177,12 @@ struct FemJson<'a> {
     mesh: &'a crate::stages::records::MeshSummary,
     criterion: &'a crate::stages::records::StressVerdict,
     fem: &'a crate::fem::FemResult,
+    /// Linear buckling load factor λ₁ of the compressive F_x case (B fixed, the load on A
+    /// towards B) under `buckling_load_n`; `null` when refused (message on stderr).
+    buckling_load_factor: Option<f64>,
+    /// The compression λ₁ refers to: `--force`, else the peak compression with a pressure
+    /// trace, else the peak pin force [N].
+    buckling_load_n: Option<f64>,
     /// Peak resident memory of this process so far (VmHWM) [MB].
     peak_memory_mb: Option<f64>,
 }
@@ -160,6 +199,8 @@ impl<'a> From<&'a DesignFem> for FemJson<'a> {
             mesh: &d.mesh,
             criterion: &d.criterion,
             fem: &d.fem,
+            buckling_load_factor: d.buckling_load_factor,
+            buckling_load_n: None,
             peak_memory_mb: crate::bench::fem_rod::peak_memory_mb(),
         }
     }

@@ -229,6 +229,9 @@ pub struct RodSolution {
     pub singularity_floor_m: Vec<f64>,
     /// Error estimates for fx and fy.
     pub estimates: [ErrorEstimate; 2],
+    /// The buckling mode of the F_x case, when buckling was computed
+    /// ([`super::buckling::rod_buckling`]; set by the caller, `None` from [`solve_rod_fields`]).
+    pub buckling: Option<super::buckling::BucklingMode>,
 }
 
 /// Analyses a rod: see the module documentation. `force_n` > 0 is the magnitude of both cases.
@@ -415,6 +418,60 @@ pub fn solve_rod_fields(
         away_from_fixed: away,
         singularity_floor_m: chase_floor,
         estimates: [e0, e1],
+        buckling: None,
     };
     Ok(solution)
+}
+
+/// The F_x case of [`solve_rod`] as supports and nodal forces: bore B fixed (all DOFs of its
+/// nodes), the uniform traction of resultant `force_n` along A→B (perpendicular to the pin axis)
+/// on bore A. Pushing A towards the fixed B, this case compresses the rod.
+#[derive(Clone, Debug)]
+pub struct RodFxCase {
+    /// Unit direction of the load, A→B.
+    pub direction: [f64; 3],
+    /// The fixed DOFs (3 · node + component).
+    pub fixed_dofs: Vec<usize>,
+    /// Nodal forces, 3 per node, N.
+    pub load: Vec<f64>,
+    /// Loaded bore A.
+    pub loaded: BoreSurface,
+    /// Fixed bore B.
+    pub fixed: BoreSurface,
+}
+
+/// The F_x case of [`solve_rod_fields`] (the same bores, direction and nodal forces), for an
+/// analysis of that load other than the static one (buckling).
+pub fn rod_fx_case(mesh: &TetMesh, bores: &BoreSpec, force_n: f64) -> Result<RodFxCase> {
+    if !(force_n.is_finite() && force_n > 0.0) {
+        return Err(FemError::InvalidInput(format!(
+            "force must be > 0 N, got {force_n}"
+        )));
+    }
+    let axis = bores.unit_axis()?;
+    let boundary = boundary_faces(mesh)?;
+    let (loaded, fixed) = find_bores(mesh, &boundary, bores)?;
+    let ab: [f64; 3] = std::array::from_fn(|j| bores.fixed_centre_m[j] - bores.loaded_centre_m[j]);
+    let along = super::boundary::dot(ab, axis);
+    let abp: [f64; 3] = std::array::from_fn(|j| ab[j] - along * axis[j]);
+    let l = norm(abp);
+    if l.is_nan() || l <= 0.0 {
+        return Err(FemError::InvalidInput(
+            "the pin centres lie on one pin axis".into(),
+        ));
+    }
+    let ex = abp.map(|v| v / l);
+    let load = uniform_traction_with_resultant(mesh, &loaded.faces, ex.map(|v| v * force_n))?;
+    let fixed_dofs = fixed
+        .nodes
+        .iter()
+        .flat_map(|&n| (0..3).map(move |j| 3 * n + j))
+        .collect();
+    Ok(RodFxCase {
+        direction: ex,
+        fixed_dofs,
+        load: load.forces,
+        loaded,
+        fixed,
+    })
 }

@@ -2,11 +2,12 @@
 //! of stage 3 (`<stem>_fx.vtu`, `_fy.vtu`: displacement, averaged and recovered von Mises, the
 //! stress tensor, the bore sets, the error indicator) and of the cycle (`cycle.vtu`: max von Mises
 //! over the revolution, the fatigue factor, the signed alternating and mean stresses), and the
-//! stress pictures of both (`von_mises_fx.svg`, `_fy.svg`, `von_mises_cycle.svg`). The records
-//! get the paths written.
+//! stress pictures of both (`von_mises_fx.svg`, `_fy.svg`, `von_mises_cycle.svg`), and the
+//! buckling mode when it was computed (`buckling_mode.vtu`). The records get the paths written.
 
 use super::atomic_write::write_atomic;
 use super::vtu::{VtuField, write_vtu};
+use crate::fem::buckling::BucklingMode;
 use crate::fem::cycle::{CycleSolution, UnitSolutions};
 use crate::fem::error::{FemError, Result};
 use crate::fem::estimate::ErrorEstimate;
@@ -15,7 +16,7 @@ use crate::fem::stress::StressField;
 use crate::fem::{BoreSurface, TetMesh};
 use crate::report::picture::{PictureOptions, render_tet10_field};
 use crate::stages::records::DesignCycle;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Writes the ParaView files `<dir>/<stem>_fx.vtu` and `_fy.vtu` of the fields `solution` on
 /// `mesh`, and the pictures of the von Mises field `<dir>/von_mises_fx.svg` and `_fy.svg`, and
@@ -31,7 +32,50 @@ pub fn write_fem_fields(
     write_fem_pictures(result, solution, mesh, dir)
 }
 
-/// The ParaView files of [`write_fem_fields`] alone (`<dir>/<stem>_fx.vtu`, `_fy.vtu`).
+/// Writes the buckling mode φ₁ (largest component 1, dimensionless; a point field `mode` and
+/// its magnitude) of the load factor λ₁ to `<dir>/buckling_mode.vtu`; returns the path.
+pub fn write_buckling_mode(dir: &Path, mesh: &TetMesh, mode: &BucklingMode) -> Result<PathBuf> {
+    std::fs::create_dir_all(dir).map_err(|e| FemError::io(dir, e))?;
+    let path = dir.join("buckling_mode.vtu");
+    let magnitude: Vec<f64> = mode
+        .mode
+        .chunks_exact(3)
+        .map(|d| (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt())
+        .collect();
+    let factor = vec![mode.load_factor; mesh.n_nodes()];
+    let load = vec![mode.load_n; mesh.n_nodes()];
+    write_vtu(
+        &path,
+        mesh,
+        &[
+            VtuField {
+                name: "buckling_mode",
+                components: 3,
+                data: &mode.mode,
+            },
+            VtuField {
+                name: "buckling_mode_magnitude",
+                components: 1,
+                data: &magnitude,
+            },
+            VtuField {
+                name: "buckling_load_factor",
+                components: 1,
+                data: &factor,
+            },
+            VtuField {
+                name: "reference_compression_N",
+                components: 1,
+                data: &load,
+            },
+        ],
+        &[],
+    )?;
+    Ok(path)
+}
+
+/// The ParaView files of [`write_fem_fields`] alone (`<dir>/<stem>_fx.vtu`, `_fy.vtu`, and
+/// `buckling_mode.vtu` when the solution carries a buckling mode).
 pub fn write_fem_vtus(
     result: &mut FemResult,
     solution: &RodSolution,
@@ -58,6 +102,9 @@ pub fn write_fem_vtus(
             &solution.away_from_fixed,
         )?;
         case.vtu = Some(path);
+    }
+    if let Some(mode) = &solution.buckling {
+        write_buckling_mode(dir, mesh, mode)?;
     }
     Ok(())
 }

@@ -60,6 +60,9 @@ pub struct RankRow<'a> {
     pub status: Status,
     /// On the Pareto front (mass, force, safety factor); see [`super::pareto`].
     pub pareto: bool,
+    /// The smallest accepted buckling load factor (`[criterion] buckling_factor`), judged where
+    /// the design has one.
+    pub buckling_required: f64,
 }
 
 impl RankRow<'_> {
@@ -81,7 +84,8 @@ impl RankRow<'_> {
             })
             .unwrap_or_default()
     }
-    /// Why a design fails: `static`, `fatigue` or both (empty when it passes or is not judged).
+    /// Why a design fails: `static`, `fatigue`, `buckling` or several, `and`-joined (empty when it
+    /// passes or is not judged).
     pub fn failing_on(&self) -> String {
         let Some(f) = self.fem else {
             return String::new();
@@ -91,12 +95,19 @@ impl RankRow<'_> {
             .fatigue_safety_factor
             .zip(c.fatigue_required)
             .is_some_and(|(n, r)| n < r);
-        match (!c.static_pass, fatigue) {
-            (true, true) => "static and fatigue".into(),
-            (true, false) => "static".into(),
-            (false, true) => "fatigue".into(),
-            (false, false) => String::new(),
-        }
+        let buckling = f
+            .buckling_load_factor
+            .is_some_and(|l| l < self.buckling_required);
+        [
+            (c.static_pass, "static"),
+            (!fatigue, "fatigue"),
+            (!buckling, "buckling"),
+        ]
+        .into_iter()
+        .filter(|(ok, _)| !ok)
+        .map(|(_, name)| name)
+        .collect::<Vec<_>>()
+        .join(" and ")
     }
 }
 
@@ -134,6 +145,7 @@ pub fn ranking(results: &StudyResults) -> Vec<RankRow<'_>> {
             fem: d.fem.as_ref(),
             cycle: d.cycle.as_ref(),
             pareto: front.contains(&d.mass.id),
+            buckling_required: results.config.criterion.buckling_factor,
             status: match &d.fem {
                 None => Status::NotJudged,
                 Some(f) if f.criterion.pass => Status::Pass,
@@ -149,6 +161,7 @@ pub fn ranking(results: &StudyResults) -> Vec<RankRow<'_>> {
             fem: None,
             cycle: None,
             pareto: false,
+            buckling_required: results.config.criterion.buckling_factor,
             status: Status::StageFailed {
                 stage: f.stage.clone(),
                 error: f.error.clone(),
@@ -183,6 +196,10 @@ struct CsvRow<'a> {
     cycle_max_von_mises_mpa: Option<f64>,
     cycle_crank_angle_of_max_deg: Option<f64>,
     fatigue_safety_factor: Option<f64>,
+    /// The linear buckling load factor under the peak compression: a column only when some
+    /// design has one (the engine study), so that other rankings keep their bytes.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    buckling_load_factor: Option<Option<f64>>,
     max_displacement_mm: Option<f64>,
     /// On the Pareto front of mass, peak force and safety factor (`pareto.md`).
     pareto_front: bool,
@@ -200,6 +217,7 @@ struct CsvRow<'a> {
 /// `ranking.csv`.
 pub fn csv(results: &StudyResults) -> Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
+    let buckling = has_buckling(results);
     for r in ranking(results) {
         let f = r.fem;
         let fx = f.map(|f| &f.fem.fx);
@@ -224,6 +242,7 @@ pub fn csv(results: &StudyResults) -> Result<Vec<u8>> {
             cycle_max_von_mises_mpa: r.cycle.map(|c| c.max_von_mises_over_cycle_mpa),
             cycle_crank_angle_of_max_deg: r.cycle.map(|c| c.crank_angle_of_max_deg),
             fatigue_safety_factor: r.cycle.map(|c| c.fatigue_safety_factor),
+            buckling_load_factor: buckling.then(|| f.and_then(|f| f.buckling_load_factor)),
             max_displacement_mm: f.map(|f| {
                 f.fem
                     .fx
@@ -263,6 +282,44 @@ pub const HEADERS: [&str; 15] = [
     "max displ. [mm]",
     "Pareto front",
 ];
+
+/// Whether any design of the study has a buckling load factor (then the tables get its column).
+pub fn has_buckling(results: &StudyResults) -> bool {
+    results.designs.iter().any(|d| {
+        d.fem
+            .as_ref()
+            .is_some_and(|f| f.buckling_load_factor.is_some())
+    })
+}
+
+/// The header of the buckling column, placed after [`BUCKLING_AFTER`] columns.
+pub const BUCKLING_HEADER: &str = "buckling load factor";
+/// Columns of [`HEADERS`] before the buckling column (after the fatigue safety factor).
+pub const BUCKLING_AFTER: usize = 8;
+
+/// The headers of the study's table: [`HEADERS`], with the buckling column when any design has a
+/// buckling load factor.
+pub fn table_headers(results: &StudyResults) -> Vec<&'static str> {
+    let mut h = HEADERS.to_vec();
+    if has_buckling(results) {
+        h.insert(BUCKLING_AFTER, BUCKLING_HEADER);
+    }
+    h
+}
+
+/// The cells of one row in [`table_headers`] order.
+pub fn table_cells(r: &RankRow, buckling: bool) -> Vec<String> {
+    let mut c = cells(r).to_vec();
+    if buckling {
+        c.insert(
+            BUCKLING_AFTER,
+            r.fem
+                .and_then(|f| f.buckling_load_factor)
+                .map_or_else(|| "—".to_string(), |l| format!("{l:.2}")),
+        );
+    }
+    c
+}
 
 /// The cells of one row of the table for people, in [`HEADERS`] order (plain text).
 pub fn cells(r: &RankRow) -> [String; 15] {
@@ -350,7 +407,14 @@ pub fn explanation(results: &StudyResults) -> String {
         } else {
             String::new()
         }
-    )
+    ) + &if has_buckling(results) {
+        format!(
+            " Buckling: a linear buckling load factor ≥ {} under the peak compression (small-end bore fixed, the compression on the big-end bore) is required too.",
+            c.buckling_factor
+        )
+    } else {
+        String::new()
+    }
 }
 
 /// Per design, the sentences that say where the model is out of its depth.
@@ -373,10 +437,15 @@ pub const VALIDITY_PREAMBLE: &str = "The stage-3 model is linear elastic and sma
 /// `ranking.md`.
 pub fn markdown(results: &StudyResults) -> String {
     let mut out = format!("# Ranking of the designs\n\n{}\n\n", explanation(results));
-    out.push_str(&format!("| {} |\n", HEADERS.join(" | ")));
-    out.push_str(&format!("|{}\n", "---|".repeat(HEADERS.len())));
+    let headers = table_headers(results);
+    let buckling = has_buckling(results);
+    out.push_str(&format!("| {} |\n", headers.join(" | ")));
+    out.push_str(&format!("|{}\n", "---|".repeat(headers.len())));
     for r in ranking(results) {
-        let cells = cells(&r).map(|c| c.replace('|', "\\|"));
+        let cells: Vec<String> = table_cells(&r, buckling)
+            .into_iter()
+            .map(|c| c.replace('|', "\\|"))
+            .collect();
         out.push_str(&format!("| {} |\n", cells.join(" | ")));
     }
     let notes = validity_notes(results);
@@ -412,7 +481,8 @@ pub fn escape(s: &str) -> String {
 /// ranking order); the design names link to their sections (`#<id>`).
 pub fn html_table(results: &StudyResults) -> String {
     let mut out = String::from("<table id=\"ranking\">\n<thead><tr>");
-    for h in HEADERS {
+    let buckling = has_buckling(results);
+    for h in table_headers(results) {
         out.push_str(&format!("<th>{}</th>", escape(h)));
     }
     out.push_str("</tr></thead>\n<tbody>\n");
@@ -422,7 +492,7 @@ pub fn html_table(results: &StudyResults) -> String {
             "<tr data-id=\"{id}\" class=\"{}\">",
             r.status.class()
         ));
-        for (k, c) in cells(&r).iter().enumerate() {
+        for (k, c) in table_cells(&r, buckling).iter().enumerate() {
             let c = escape(c);
             if k == 1 {
                 out.push_str(&format!("<td><a href=\"#{id}\">{c}</a></td>"));

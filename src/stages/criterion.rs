@@ -1,14 +1,15 @@
 //! The stress criterion of a design (SPEC "Outputs": yield with a safety factor, judged on the
 //! convergent measure, optionally plus its estimated error), where the linear small-displacement
-//! model is out of its depth, and the fatigue factor of the cycle added to the verdict.
+//! model is out of its depth, and the fatigue factor of the cycle and the buckling load factor
+//! (when computed) added to the verdict.
 
 use super::records::{DesignCycle, StressVerdict};
 use crate::config::StudyConfig;
 use crate::fem::FemResult;
 
 /// Adds the cycle's fatigue safety factor to the verdict when the configuration judges fatigue:
-/// the design passes when it passes statically and its Goodman factor is at least
-/// `criterion.fatigue_safety_factor`.
+/// the design passes when it passed so far (statically, and on buckling when judged) and its
+/// Goodman factor is at least `criterion.fatigue_safety_factor`.
 pub fn judge_fatigue(verdict: &mut StressVerdict, cycle: &DesignCycle, config: &StudyConfig) {
     if !config.criterion.fatigue {
         return;
@@ -16,7 +17,13 @@ pub fn judge_fatigue(verdict: &mut StressVerdict, cycle: &DesignCycle, config: &
     let required = config.criterion.fatigue_safety_factor;
     verdict.fatigue_safety_factor = Some(cycle.fatigue_safety_factor);
     verdict.fatigue_required = Some(required);
-    verdict.pass = verdict.static_pass && cycle.fatigue_safety_factor >= required;
+    verdict.pass = verdict.pass && cycle.fatigue_safety_factor >= required;
+}
+
+/// Adds the linear buckling load factor λ₁ to the verdict: the design passes when it passed so
+/// far and λ₁ ≥ `criterion.buckling_factor` (default 3).
+pub fn judge_buckling(verdict: &mut StressVerdict, load_factor: f64, config: &StudyConfig) {
+    verdict.pass = verdict.pass && load_factor >= config.criterion.buckling_factor;
 }
 
 /// Displacements above this fraction of the centre distance are beyond small-displacement

@@ -13,12 +13,19 @@
 //! stress outside a fixed physical band around the fixed bore (the fully fixed bore edge is a
 //! singularity whose peak grows with refinement), optionally plus its estimated error; the raw
 //! peak is reported beside it.
+//!
+//! **Buckling.** With a pressure trace (`[engine] pressure_trace`, the engine study) the stage
+//! also computes the linear buckling load factor of the rod under its peak compression
+//! ([`buckling`]: the F_x case with that magnitude, B fixed, load on A towards B) and judges it
+//! against `[criterion] buckling_factor`; without a trace the default study does not (its results
+//! stay as they were). `rodstudy fem` always reports it.
 
-use super::criterion::verdict;
+use super::criterion::{judge_buckling, verdict};
 use super::records::{AdaptiveSummary, DesignFem, LoadedDesign, MeshSummary, StageMesh};
 use super::rod_surface::{RodFrameSurface, rod_frame_surface};
 use crate::config::{FemConfig, StudyConfig};
 use crate::fem::adapt::{AdaptOptions, adaptive_rod};
+use crate::fem::buckling::{BucklingMode, BucklingOptions, BucklingSolution, rod_buckling};
 use crate::fem::facets::{FacetScale, reentrant_edges};
 use crate::fem::refinement::{RefinementStudy, refinement_study};
 use crate::fem::rod::{RodSolution, solve_rod_fields};
@@ -98,11 +105,71 @@ pub fn fem(
     work_dir: &Path,
     mode: &MeshMode,
 ) -> Result<FemOutcome> {
-    match mode {
+    let mut outcome = match mode {
         MeshMode::Fixed(size_mm) => fem_fixed(design, force_n, config, work_dir, *size_mm),
         MeshMode::Adaptive(a) => fem_adaptive(design, force_n, config, work_dir, a),
         MeshMode::User(file) => fem_user_mesh(design, force_n, config, work_dir, file),
+    }?;
+    // the engine study (a pressure trace) also judges buckling under the peak compression
+    if config.engine.pressure_trace.is_some() {
+        let load = buckling_load(design, config)?;
+        add_buckling(&mut outcome, config, load)
+            .with_context(|| format!("{}: buckling", design.file.display()))?;
     }
+    Ok(outcome)
+}
+
+/// The load of the buckling case of a design: with a pressure trace its peak compression along
+/// A→B (`peak_compression_n` of stage 2), else its peak pin force (the F_x case's magnitude).
+pub fn buckling_load(design: &LoadedDesign, config: &StudyConfig) -> Result<f64> {
+    let mass = super::mass::mass(design)?;
+    let (dynamics, _) = super::dynamics::dynamics_with(
+        &mass,
+        &config.driven_scene(),
+        config.driven.gravity,
+        &config.engine,
+        crate::mechanism::Method::ClosedForm,
+    )?;
+    Ok(dynamics
+        .peak_compression_n
+        .unwrap_or(dynamics.peak_pin_force_n))
+}
+
+/// Linear buckling of the rod on stage 3's mesh (supports as stage 3: bore B fixed) under the
+/// compression `compression_n` on bore A towards B (the F_x case;
+/// [`crate::fem::buckling::rod_buckling`]): the smallest positive load factor λ₁ and its mode.
+pub fn buckling(
+    stage: &StageMesh,
+    config: &StudyConfig,
+    compression_n: f64,
+) -> Result<BucklingSolution> {
+    Ok(rod_buckling(
+        &stage.mesh,
+        &Material::from(&config.fem),
+        &stage.bores,
+        compression_n,
+        RodOptions::default().quadrature,
+        &BucklingOptions::default(),
+    )?)
+}
+
+/// [`buckling`] on the outcome's mesh: the factor into the record (and the verdict:
+/// `[criterion] buckling_factor`), the mode into the fields (the report writes
+/// `buckling_mode.vtu`).
+pub fn add_buckling(
+    outcome: &mut FemOutcome,
+    config: &StudyConfig,
+    compression_n: f64,
+) -> Result<()> {
+    let b = buckling(&outcome.mesh, config, compression_n)?;
+    outcome.record.buckling_load_factor = Some(b.load_factor);
+    judge_buckling(&mut outcome.record.criterion, b.load_factor, config);
+    outcome.solution.buckling = Some(BucklingMode {
+        load_factor: b.load_factor,
+        load_n: compression_n,
+        mode: b.mode,
+    });
+    Ok(())
 }
 
 /// What every mode shares: the rod-frame surface, its bores, the material, the singular edges
@@ -208,6 +275,7 @@ impl Setup {
                 mesh: summary,
                 fem: solution.result.clone(),
                 criterion,
+                buckling_load_factor: None,
             },
             mesh: StageMesh {
                 mesh,

@@ -148,6 +148,11 @@ pub struct DesignFem {
     pub mesh: MeshSummary,
     pub fem: FemResult,
     pub criterion: StressVerdict,
+    /// Linear buckling load factor λ₁ of the rod under its peak compression (the F_x case: B
+    /// fixed, the compression on A towards B; [`crate::fem::buckling`]): computed in the study
+    /// only with a pressure trace (`[engine] pressure_trace`), absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub buckling_load_factor: Option<f64>,
 }
 
 /// The mesh stage 3 ended on, in the rod frame (m), with what a later stage on the same mesh
