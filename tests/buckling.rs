@@ -11,9 +11,10 @@
 use std::path::{Path, PathBuf};
 
 use rodstudy::fem::boundary::boundary_faces;
-use rodstudy::fem::buckling::{BucklingOptions, BucklingProblem, rod_buckling, solve_buckling};
+use rodstudy::fem::buckling::{BucklingOptions, BucklingProblem, solve_buckling};
 use rodstudy::fem::load::uniform_traction_with_resultant;
 use rodstudy::fem::mesh::structured::box_tet10;
+use rodstudy::fem::rod_buckling::rod_buckling;
 use rodstudy::fem::*;
 use rodstudy::mesher::{mesh_stl, write_rodmesh};
 

@@ -16,6 +16,8 @@
 //! "Input deck format" and the keyword sections; the element node order and face numbering from
 //! its "C3D10" section. Deck units are kept as given (no conversion).
 
+pub mod cards;
+pub mod mesh_cards;
 pub mod model;
 pub mod output;
 pub mod parse;

@@ -119,6 +119,41 @@ fn params(s: &str) -> Vec<(String, String)> {
         .collect()
 }
 
+pub(super) fn num(path: &Path, d: &DataLine, k: usize, what: &str) -> Result<f64> {
+    let f = d
+        .fields
+        .get(k)
+        .ok_or_else(|| error(path, d.line, format!("missing {what} (field {})", k + 1)))?;
+    // Fortran-style exponents (1.0D+03) are accepted as ccx accepts them
+    f.replace(['d', 'D'], "e")
+        .parse()
+        .map_err(|_| error(path, d.line, format!("{what}: '{f}' is not a number")))
+}
+
+pub(super) fn int(path: &Path, line: usize, f: &str, what: &str) -> Result<i64> {
+    f.parse()
+        .map_err(|_| error(path, line, format!("{what}: '{f}' is not an integer")))
+}
+
+pub(super) fn required<'a>(path: &Path, card: &'a Card, name: &str) -> Result<&'a str> {
+    match card.param(name) {
+        Some(v) if !v.is_empty() => Ok(v),
+        _ => Err(error(
+            path,
+            card.line,
+            format!("*{} needs {name}=", card.keyword),
+        )),
+    }
+}
+
+pub(super) fn push_unique(set: &mut Vec<usize>, items: impl IntoIterator<Item = usize>) {
+    for i in items {
+        if !set.contains(&i) {
+            set.push(i);
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

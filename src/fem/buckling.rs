@@ -31,13 +31,11 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::assembly::{DofMap, SparseSym, assemble};
-use super::bores::BoreSpec;
 use super::element::QuadratureChoice;
 use super::error::{FemError, Result};
 use super::geometric_stiffness::{GeometricKernel, geometric_kernel};
 use super::material::Material;
 use super::mesh::TetMesh;
-use super::rod::rod_fx_case;
 use super::solver::{CholeskyFactor, SymbolicFactor};
 
 /// Options of [`solve_buckling`].
@@ -395,28 +393,4 @@ pub struct BucklingMode {
     pub load_n: f64,
     /// φ₁, 3 per node, largest component +1.
     pub mode: Vec<f64>,
-}
-
-/// Linear buckling of a rod under the compressive F_x case of stage 3 ([`rod_fx_case`]): bore B
-/// fixed, bore A loaded by a uniform traction of resultant `compression_n` along A→B (towards the
-/// fixed bore: compression). λ₁ · `compression_n` is the linear buckling load.
-pub fn rod_buckling(
-    mesh: &TetMesh,
-    material: &Material,
-    bores: &BoreSpec,
-    compression_n: f64,
-    quadrature: QuadratureChoice,
-    options: &BucklingOptions,
-) -> Result<BucklingSolution> {
-    let case = rod_fx_case(mesh, bores, compression_n)?;
-    solve_buckling(
-        &BucklingProblem {
-            mesh,
-            material: *material,
-            fixed_dofs: case.fixed_dofs,
-            load: case.load,
-            quadrature,
-        },
-        options,
-    )
 }

@@ -43,6 +43,7 @@ pub mod quadrature;
 pub mod recovery;
 pub mod refinement;
 pub mod rod;
+pub mod rod_buckling;
 pub mod shape;
 pub mod solver;
 pub mod statics;

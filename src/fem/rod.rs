@@ -230,7 +230,7 @@ pub struct RodSolution {
     /// Error estimates for fx and fy.
     pub estimates: [ErrorEstimate; 2],
     /// The buckling mode of the F_x case, when buckling was computed
-    /// ([`super::buckling::rod_buckling`]; set by the caller, `None` from [`solve_rod_fields`]).
+    /// ([`super::rod_buckling::rod_buckling`]; set by the caller, `None` from [`solve_rod_fields`]).
     pub buckling: Option<super::buckling::BucklingMode>,
 }
 

@@ -25,10 +25,11 @@ use super::records::{AdaptiveSummary, DesignFem, LoadedDesign, MeshSummary, Stag
 use super::rod_surface::{RodFrameSurface, rod_frame_surface};
 use crate::config::{FemConfig, StudyConfig};
 use crate::fem::adapt::{AdaptOptions, adaptive_rod};
-use crate::fem::buckling::{BucklingMode, BucklingOptions, BucklingSolution, rod_buckling};
+use crate::fem::buckling::{BucklingMode, BucklingOptions, BucklingSolution};
 use crate::fem::facets::{FacetScale, reentrant_edges};
 use crate::fem::refinement::{RefinementStudy, refinement_study};
 use crate::fem::rod::{RodSolution, solve_rod_fields};
+use crate::fem::rod_buckling::rod_buckling;
 use crate::fem::{BoreSpec, Material, RodOptions, TetMesh};
 use crate::mesher::{GmshRodMesher, MESHER_SCRIPT, MeshReport, StepInRodFrame, read_volume_mesh};
 use crate::python_env::{pipeline_script, python};
@@ -137,7 +138,7 @@ pub fn buckling_load(design: &LoadedDesign, config: &StudyConfig) -> Result<f64>
 
 /// Linear buckling of the rod on stage 3's mesh (supports as stage 3: bore B fixed) under the
 /// compression `compression_n` on bore A towards B (the F_x case;
-/// [`crate::fem::buckling::rod_buckling`]): the smallest positive load factor λ₁ and its mode.
+/// [`crate::fem::rod_buckling::rod_buckling`]): the smallest positive load factor λ₁ and its mode.
 pub fn buckling(
     stage: &StageMesh,
     config: &StudyConfig,

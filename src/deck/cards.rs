@@ -1,0 +1,487 @@
+//! The cards of a deck read into a [`Model`], keyword by keyword (the subset listed in
+//! [`super::model`]); every keyword, parameter and data form outside it is refused with its line.
+
+use std::path::Path;
+
+use super::model::*;
+use super::parse::{Card, error, int, num, push_unique, required};
+use crate::fem::error::Result;
+
+/// Parameters each keyword accepts (any other is refused).
+fn allowed_params(keyword: &str) -> Option<&'static [&'static str]> {
+    Some(match keyword {
+        "HEADING" | "DENSITY" | "END STEP" => &[],
+        "NODE" => &["NSET"],
+        "ELEMENT" => &["TYPE", "ELSET"],
+        "NSET" => &["NSET", "GENERATE"],
+        "ELSET" => &["ELSET", "GENERATE"],
+        "MATERIAL" => &["NAME"],
+        "ELASTIC" => &["TYPE"],
+        "SOLID SECTION" => &["ELSET", "MATERIAL"],
+        "BOUNDARY" => &["OP"],
+        "CLOAD" | "DLOAD" => &["OP"],
+        "STEP" => &["INC", "NLGEOM"],
+        "STATIC" => &["SOLVER"],
+        "NODE PRINT" => &["NSET", "TOTALS", "FREQUENCY", "GLOBAL"],
+        "EL PRINT" => &["ELSET", "TOTALS", "FREQUENCY", "GLOBAL"],
+        "NODE FILE" | "EL FILE" => &["FREQUENCY", "OUTPUT", "GLOBAL"],
+        _ => return None,
+    })
+}
+
+impl Model {
+    /// Builds the model from the cards of `path`.
+    pub fn from_cards(path: &Path, cards: &[Card]) -> Result<Model> {
+        let mut m = Model::default();
+        let mut material: Option<String> = None;
+        // supports and loads of the model section and of the steps so far
+        let mut state = Step::default();
+        let mut in_step = false;
+        let mut first_cload = true;
+        let mut first_dload = true;
+        for card in cards {
+            let kw = card.keyword.as_str();
+            let Some(allowed) = allowed_params(kw) else {
+                return Err(error(
+                    path,
+                    card.line,
+                    format!(
+                        "*{kw} is not supported (rodstudy solves linear static tet models: see \
+                         `rodstudy solve --help` for the keywords it reads)"
+                    ),
+                ));
+            };
+            if let Some((p, _)) = card
+                .params
+                .iter()
+                .find(|(p, _)| !allowed.contains(&p.as_str()))
+            {
+                return Err(error(
+                    path,
+                    card.line,
+                    format!("*{kw}: parameter {p} is not supported"),
+                ));
+            }
+            let step_kw = matches!(
+                kw,
+                "STATIC"
+                    | "CLOAD"
+                    | "DLOAD"
+                    | "NODE PRINT"
+                    | "EL PRINT"
+                    | "NODE FILE"
+                    | "EL FILE"
+                    | "END STEP"
+            );
+            if step_kw && !in_step {
+                return Err(error(path, card.line, format!("*{kw} outside a *STEP")));
+            }
+            if in_step
+                && matches!(
+                    kw,
+                    "NODE"
+                        | "ELEMENT"
+                        | "NSET"
+                        | "ELSET"
+                        | "MATERIAL"
+                        | "ELASTIC"
+                        | "DENSITY"
+                        | "SOLID SECTION"
+                        | "STEP"
+                )
+            {
+                return Err(error(
+                    path,
+                    card.line,
+                    format!("*{kw} inside a step (missing *END STEP?)"),
+                ));
+            }
+            if !matches!(kw, "ELASTIC" | "DENSITY") {
+                if kw != "MATERIAL" {
+                    material = None;
+                }
+            } else if material.is_none() {
+                return Err(error(path, card.line, format!("*{kw} outside a *MATERIAL")));
+            }
+            let needs_data = matches!(
+                kw,
+                "NSET"
+                    | "ELSET"
+                    | "ELASTIC"
+                    | "DENSITY"
+                    | "BOUNDARY"
+                    | "CLOAD"
+                    | "DLOAD"
+                    | "NODE PRINT"
+                    | "EL PRINT"
+            );
+            if needs_data && card.data.is_empty() {
+                return Err(error(path, card.line, format!("*{kw} without data lines")));
+            }
+            let max_data = match kw {
+                "MATERIAL" | "STEP" | "END STEP" => 0,
+                // a solid section may carry one data line (a thickness, unused for solids)
+                "SOLID SECTION" => 1,
+                _ => usize::MAX,
+            };
+            if card.data.len() > max_data {
+                return Err(error(
+                    path,
+                    card.data[max_data].line,
+                    format!("*{kw} takes no further data lines"),
+                ));
+            }
+            match kw {
+                "HEADING" => {}
+                "NODE" => m.read_nodes(path, card)?,
+                "ELEMENT" => m.read_elements(path, card)?,
+                "NSET" | "ELSET" => m.read_set(path, card)?,
+                "MATERIAL" => {
+                    let name = required(path, card, "NAME")?.to_ascii_uppercase();
+                    if m.materials.contains_key(&name) {
+                        return Err(error(
+                            path,
+                            card.line,
+                            format!("material {name} defined twice"),
+                        ));
+                    }
+                    m.materials.insert(
+                        name.clone(),
+                        MaterialDef {
+                            line: card.line,
+                            ..Default::default()
+                        },
+                    );
+                    material = Some(name);
+                }
+                "ELASTIC" => {
+                    if let Some(t) = card.param("TYPE")
+                        && !t.eq_ignore_ascii_case("ISO")
+                    {
+                        return Err(error(
+                            path,
+                            card.line,
+                            format!("*ELASTIC, TYPE={t}: only isotropic (TYPE=ISO) is supported"),
+                        ));
+                    }
+                    let d = &card.data[0];
+                    if card.data.len() > 1 || d.fields.len() > 3 {
+                        return Err(error(
+                            path,
+                            d.line,
+                            "temperature-dependent elastic constants are not supported",
+                        ));
+                    }
+                    let e = num(path, d, 0, "Young's modulus")?;
+                    let nu = num(path, d, 1, "Poisson's ratio")?;
+                    let mat = m
+                        .materials
+                        .get_mut(material.as_ref().expect("checked"))
+                        .expect("defined");
+                    mat.elastic = Some((e, nu));
+                }
+                "DENSITY" => {
+                    let d = &card.data[0];
+                    if card.data.len() > 1 || d.fields.len() > 2 {
+                        return Err(error(
+                            path,
+                            d.line,
+                            "temperature-dependent density is not supported",
+                        ));
+                    }
+                    let rho = num(path, d, 0, "density")?;
+                    let mat = m
+                        .materials
+                        .get_mut(material.as_ref().expect("checked"))
+                        .expect("defined");
+                    mat.density = Some(rho);
+                }
+                "SOLID SECTION" => {
+                    let elset = required(path, card, "ELSET")?.to_ascii_uppercase();
+                    let mat = required(path, card, "MATERIAL")?.to_ascii_uppercase();
+                    if !m.elsets.contains_key(&elset) {
+                        return Err(error(
+                            path,
+                            card.line,
+                            format!("element set {elset} is not defined"),
+                        ));
+                    }
+                    m.sections.push((elset, mat, card.line));
+                }
+                "BOUNDARY" => {
+                    if let Some(op) = card.param("OP")
+                        && !op.eq_ignore_ascii_case("MOD")
+                    {
+                        return Err(error(
+                            path,
+                            card.line,
+                            format!(
+                                "*BOUNDARY, OP={op}: only OP=MOD (supports carry over) is supported"
+                            ),
+                        ));
+                    }
+                    for d in &card.data {
+                        let (name, nodes) = m.node_target(path, d)?;
+                        let f1 = d
+                            .fields
+                            .get(1)
+                            .ok_or_else(|| error(path, d.line, "missing first dof"))?;
+                        let first = int(
+                            path,
+                            d.line,
+                            f1,
+                            "first dof (named supports such as ENCASTRE are not supported)",
+                        )?;
+                        let last = match d.fields.get(2) {
+                            Some(f) if !f.is_empty() => int(path, d.line, f, "last dof")?,
+                            _ => first,
+                        };
+                        let value = if d.fields.len() > 3 {
+                            num(path, d, 3, "prescribed value")?
+                        } else {
+                            0.0
+                        };
+                        if d.fields.len() > 4 {
+                            return Err(error(
+                                path,
+                                d.line,
+                                "a *BOUNDARY line is 'node|nset, first, last, value'",
+                            ));
+                        }
+                        if !(1..=3).contains(&first) || !(first..=3).contains(&last) {
+                            return Err(error(
+                                path,
+                                d.line,
+                                format!(
+                                    "dofs {first}..{last}: only displacements 1-3 exist on solid elements"
+                                ),
+                            ));
+                        }
+                        for &n in &nodes {
+                            for dof in first..=last {
+                                state.boundary.insert((n, (dof - 1) as usize), value);
+                            }
+                        }
+                        push_unique(state.supported_sets.entry(name).or_default(), nodes);
+                    }
+                }
+                "STEP" => {
+                    if let Some(v) = card.param("NLGEOM")
+                        && !v.eq_ignore_ascii_case("NO")
+                    {
+                        return Err(error(
+                            path,
+                            card.line,
+                            "*STEP, NLGEOM: only linear analysis is supported",
+                        ));
+                    }
+                    in_step = true;
+                    first_cload = true;
+                    first_dload = true;
+                    state.line = card.line;
+                    state.static_seen = false;
+                    state.node_print.clear();
+                    state.el_print.clear();
+                    state.file_vars.clear();
+                }
+                "STATIC" => {
+                    if card.data.len() > 1 {
+                        return Err(error(
+                            path,
+                            card.data[1].line,
+                            "*STATIC takes one data line",
+                        ));
+                    }
+                    state.static_seen = true;
+                }
+                "CLOAD" => {
+                    if op_new(path, card)? && first_cload {
+                        state.cloads.clear();
+                    }
+                    first_cload = false;
+                    for d in &card.data {
+                        let (_, nodes) = m.node_target(path, d)?;
+                        let f1 = d
+                            .fields
+                            .get(1)
+                            .ok_or_else(|| error(path, d.line, "missing dof"))?;
+                        let dof = int(path, d.line, f1, "dof")?;
+                        if !(1..=3).contains(&dof) {
+                            return Err(error(
+                                path,
+                                d.line,
+                                format!("dof {dof}: only forces 1-3 exist on solid elements"),
+                            ));
+                        }
+                        let v = num(path, d, 2, "load")?;
+                        if d.fields.len() > 3 {
+                            return Err(error(
+                                path,
+                                d.line,
+                                "a *CLOAD line is 'node|nset, dof, value'",
+                            ));
+                        }
+                        for &n in &nodes {
+                            state.cloads.insert((n, (dof - 1) as usize), v);
+                        }
+                    }
+                }
+                "DLOAD" => {
+                    if op_new(path, card)? && first_dload {
+                        state.pressures.clear();
+                        state.gravity.clear();
+                    }
+                    first_dload = false;
+                    for d in &card.data {
+                        let elements = m.element_target(path, d)?;
+                        let label = d
+                            .fields
+                            .get(1)
+                            .map(|s| s.to_ascii_uppercase())
+                            .unwrap_or_default();
+                        match label.as_str() {
+                            "P1" | "P2" | "P3" | "P4" => {
+                                let face = (label.as_bytes()[1] - b'1') as usize;
+                                let p = num(path, d, 2, "pressure")?;
+                                if d.fields.len() > 3 {
+                                    return Err(error(
+                                        path,
+                                        d.line,
+                                        "a pressure line is 'element|elset, Pk, p'",
+                                    ));
+                                }
+                                for &e in &elements {
+                                    state.pressures.insert((e, face), p);
+                                }
+                            }
+                            "GRAV" => {
+                                let g = num(path, d, 2, "gravity magnitude")?;
+                                let dir = [
+                                    num(path, d, 3, "nx")?,
+                                    num(path, d, 4, "ny")?,
+                                    num(path, d, 5, "nz")?,
+                                ];
+                                let n =
+                                    (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
+                                if n == 0.0 || !n.is_finite() || d.fields.len() > 6 {
+                                    return Err(error(
+                                        path,
+                                        d.line,
+                                        "a GRAV line is 'elset, GRAV, g, nx, ny, nz' with a non-zero direction",
+                                    ));
+                                }
+                                for &e in &elements {
+                                    state.gravity.insert(
+                                        e,
+                                        Grav {
+                                            g,
+                                            dir: dir.map(|v| v / n),
+                                        },
+                                    );
+                                }
+                            }
+                            _ => {
+                                return Err(error(
+                                    path,
+                                    d.line,
+                                    format!(
+                                        "*DLOAD label '{label}' is not supported (P1-P4 on C3D10 faces, GRAV)"
+                                    ),
+                                ));
+                            }
+                        }
+                    }
+                }
+                "NODE PRINT" | "EL PRINT" | "NODE FILE" | "EL FILE" => {
+                    let mut vars = Vec::new();
+                    for d in &card.data {
+                        for f in &d.fields {
+                            let v = f.to_ascii_uppercase();
+                            let ok = match kw {
+                                "EL PRINT" => v == "S",
+                                _ => matches!(v.as_str(), "U" | "S" | "RF"),
+                            };
+                            if !ok {
+                                return Err(error(
+                                    path,
+                                    d.line,
+                                    format!(
+                                        "*{kw}: output variable '{f}' is not supported (U, S, RF)"
+                                    ),
+                                ));
+                            }
+                            if !vars.contains(&v) {
+                                vars.push(v);
+                            }
+                        }
+                    }
+                    match kw {
+                        "NODE PRINT" => {
+                            let set = required(path, card, "NSET")?.to_ascii_uppercase();
+                            if !m.nsets.contains_key(&set) {
+                                return Err(error(
+                                    path,
+                                    card.line,
+                                    format!("node set {set} is not defined"),
+                                ));
+                            }
+                            let totals = card
+                                .param("TOTALS")
+                                .is_some_and(|t| !t.eq_ignore_ascii_case("NO"));
+                            state.node_print.push((set, vars, totals));
+                        }
+                        "EL PRINT" => {
+                            let set = required(path, card, "ELSET")?.to_ascii_uppercase();
+                            if !m.elsets.contains_key(&set) {
+                                return Err(error(
+                                    path,
+                                    card.line,
+                                    format!("element set {set} is not defined"),
+                                ));
+                            }
+                            state.el_print.push((set, vars));
+                        }
+                        _ => {
+                            for v in vars {
+                                if !state.file_vars.contains(&v) {
+                                    state.file_vars.push(v);
+                                }
+                            }
+                        }
+                    }
+                }
+                "END STEP" => {
+                    if !state.static_seen {
+                        return Err(error(
+                            path,
+                            card.line,
+                            "a step without *STATIC (only linear static steps are supported)",
+                        ));
+                    }
+                    m.steps.push(state.clone());
+                    in_step = false;
+                }
+                _ => unreachable!("allowed_params covers the keywords"),
+            }
+        }
+        if in_step {
+            return Err(error(path, state.line, "*STEP without *END STEP"));
+        }
+        if m.elements.is_empty() {
+            return Err(error(path, 0, "no C3D10/C3D4 elements"));
+        }
+        if m.steps.is_empty() {
+            return Err(error(path, 0, "no *STEP"));
+        }
+        Ok(m)
+    }
+}
+
+fn op_new(path: &Path, card: &Card) -> Result<bool> {
+    match card.param("OP") {
+        None => Ok(false),
+        Some(v) if v.eq_ignore_ascii_case("MOD") => Ok(false),
+        Some(v) if v.eq_ignore_ascii_case("NEW") => Ok(true),
+        Some(v) => Err(error(path, card.line, format!("OP={v}: NEW or MOD"))),
+    }
+}
