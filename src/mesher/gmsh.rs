@@ -164,6 +164,25 @@ fn run(python: &Path, script: &Path, args: &[&std::ffi::OsStr]) -> Result<(Strin
     Ok((last.to_string(), secs))
 }
 
+/// Runs a meshing command of the script and reads what it made: its JSON report, and the
+/// `.rodmesh` it names, checked to hold the elements reported.
+fn run_mesher(python: &Path, script: &Path, args: &[&std::ffi::OsStr]) -> Result<MeshedRod> {
+    let (json, secs) = run(python, script, args)?;
+    let mut report: MeshReport = serde_json::from_str(&json)
+        .map_err(|e| FemError::Mesher(format!("cannot parse the mesher's report ({e}): {json}")))?;
+    report.seconds_wall = secs;
+    let mesh = read_rodmesh(&report.rodmesh)?;
+    if mesh.n_elements() != report.elements {
+        return Err(FemError::Mesher(format!(
+            "{} has {} elements, the mesher reported {}",
+            report.rodmesh.display(),
+            mesh.n_elements(),
+            report.elements
+        )));
+    }
+    Ok(MeshedRod { mesh, report })
+}
+
 /// What to ask of the mesher beyond the STL and the output folder.
 #[derive(Clone, Debug, Default)]
 pub struct MeshRequest<'a> {
@@ -230,20 +249,7 @@ pub fn mesh_stl_with(
     if let Some(n) = request.name {
         args.extend(["--name".as_ref(), std::ffi::OsStr::new(n)]);
     }
-    let (json, secs) = run(python, script, &args)?;
-    let mut report: MeshReport = serde_json::from_str(&json)
-        .map_err(|e| FemError::Mesher(format!("cannot parse the mesher's report ({e}): {json}")))?;
-    report.seconds_wall = secs;
-    let mesh = read_rodmesh(&report.rodmesh)?;
-    if mesh.n_elements() != report.elements {
-        return Err(FemError::Mesher(format!(
-            "{} has {} elements, the mesher reported {}",
-            report.rodmesh.display(),
-            mesh.n_elements(),
-            report.elements
-        )));
-    }
-    Ok(MeshedRod { mesh, report })
+    run_mesher(python, script, &args)
 }
 
 /// A STEP solid to mesh in the rod frame: `p' = scale · R (p − origin)`, R's rows the frame's
@@ -303,20 +309,7 @@ pub fn mesh_step_with(
     if let Some(n) = request.name {
         args.extend(["--name".as_ref(), std::ffi::OsStr::new(n)]);
     }
-    let (json, secs) = run(python, script, &args)?;
-    let mut report: MeshReport = serde_json::from_str(&json)
-        .map_err(|e| FemError::Mesher(format!("cannot parse the mesher's report ({e}): {json}")))?;
-    report.seconds_wall = secs;
-    let mesh = read_rodmesh(&report.rodmesh)?;
-    if mesh.n_elements() != report.elements {
-        return Err(FemError::Mesher(format!(
-            "{} has {} elements, the mesher reported {}",
-            report.rodmesh.display(),
-            mesh.n_elements(),
-            report.elements
-        )));
-    }
-    Ok(MeshedRod { mesh, report })
+    run_mesher(python, script, &args)
 }
 
 /// Converts a user's volume mesh (anything meshio reads: gmsh .msh, Abaqus/CalculiX .inp, VTU,
