@@ -135,3 +135,59 @@ fn three_shards_merge_into_the_one_machine_reports() {
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(e.contains("not a shard"), "{e}");
 }
+
+/// With an engine (the example pressure trace over 720°), the merge recomputes each design's
+/// history as the study did: gas force included, the `gas_force_n` column kept; the merged
+/// reports are the one-machine study's, byte for byte.
+#[test]
+fn shards_of_an_engine_study_merge_into_its_reports() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let config = root.join("pipeline/examples/engine.toml");
+    let config = config.to_str().unwrap();
+    let tmp = tempfile::tempdir().unwrap();
+    let t = tmp.path();
+    let designs = t.join("designs");
+    std::fs::create_dir(&designs).unwrap();
+    for stem in ["design1", "design5"] {
+        for ext in ["stl", "toml"] {
+            std::fs::copy(
+                root.join("designs").join(format!("{stem}.{ext}")),
+                designs.join(format!("{stem}.{ext}")),
+            )
+            .unwrap();
+        }
+    }
+    study(&designs, &t.join("whole"), &["--config", config]);
+    for k in 1..=2 {
+        study(
+            &designs,
+            &t.join(format!("s{k}")),
+            &["--config", config, "--shard", &format!("{k}/2")],
+        );
+    }
+    ok(&rodstudy(&[
+        "merge",
+        t.join("s1").to_str().unwrap(),
+        t.join("s2").to_str().unwrap(),
+        "--out",
+        t.join("merged").to_str().unwrap(),
+    ]));
+    for f in [
+        "results.json",
+        "ranking.csv",
+        "design1/pin_force.csv",
+        "design5/pin_force.csv",
+    ] {
+        let whole = std::fs::read(t.join("whole").join(f)).unwrap();
+        assert_eq!(
+            whole,
+            std::fs::read(t.join("merged").join(f)).unwrap(),
+            "{f}"
+        );
+    }
+    let csv = std::fs::read_to_string(t.join("merged/design1/pin_force.csv")).unwrap();
+    assert!(
+        csv.lines().next().unwrap().ends_with(",gas_force_n"),
+        "{csv:.200}"
+    );
+}

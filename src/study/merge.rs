@@ -11,10 +11,10 @@ use super::results::{DesignResult, FailedDesign, StudyResults};
 use super::shard::{ShardRecord, check_complete};
 use crate::config::StudyConfig;
 use crate::geometry::design::DesignMass;
-use crate::mechanism::{DrivenResult, Method, driven_scene};
+use crate::mechanism::{DrivenResult, Method};
 use crate::report::atomic_write::write_atomic;
 use crate::report::file_safe;
-use crate::stages::dynamics::{mechanism_for, rod_inertia};
+use crate::stages;
 use crate::stages::records::{DesignCycle, DesignDynamics, DesignFem};
 use anyhow::{Context, Result, bail};
 use serde::Deserialize;
@@ -43,13 +43,14 @@ struct ShardDesign {
 
 /// The pin-force history of a design (the driven scene, closed form).
 pub fn history_of(mass: &DesignMass, config: &StudyConfig) -> Result<DrivenResult> {
-    let params = mechanism_for(mass, config.driven.gravity);
-    Ok(driven_scene(
-        &params,
-        &rod_inertia(mass),
+    // as the study computed it: the configured engine (gas force over 720° with a trace)
+    stages::dynamics::history(
+        mass,
         &config.driven_scene(),
+        config.driven.gravity,
+        &config.engine,
         Method::ClosedForm,
-    )?)
+    )
 }
 
 fn read_shard(dir: &Path) -> Result<ShardFile> {
