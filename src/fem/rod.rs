@@ -260,21 +260,8 @@ pub fn solve_rod_fields(
             "force must be > 0 N, got {force_n}"
         )));
     }
-    let axis = bores.unit_axis()?;
-    let boundary = boundary_faces(mesh)?;
-    let (loaded, fixed) = find_bores(mesh, &boundary, bores)?;
-
-    // directions: x along A→B (perpendicular to the pin axis), y = axis × x
-    let ab: [f64; 3] = std::array::from_fn(|j| bores.fixed_centre_m[j] - bores.loaded_centre_m[j]);
-    let along = super::boundary::dot(ab, axis);
-    let abp: [f64; 3] = std::array::from_fn(|j| ab[j] - along * axis[j]);
-    let l = norm(abp);
-    if l.is_nan() || l <= 0.0 {
-        return Err(FemError::InvalidInput(
-            "the pin centres lie on one pin axis".into(),
-        ));
-    }
-    let ex = abp.map(|v| v / l);
+    let (loaded, fixed, axis, ex) = bores_and_direction(mesh, bores)?;
+    // y = axis × x, in the plane of motion
     let ey = cross(axis, ex);
     let cases = [("fx", ex), ("fy", ey)];
     let loads = cases
@@ -440,14 +427,12 @@ pub struct RodFxCase {
     pub fixed: BoreSurface,
 }
 
-/// The F_x case of [`solve_rod_fields`] (the same bores, direction and nodal forces), for an
-/// analysis of that load other than the static one (buckling).
-pub fn rod_fx_case(mesh: &TetMesh, bores: &BoreSpec, force_n: f64) -> Result<RodFxCase> {
-    if !(force_n.is_finite() && force_n > 0.0) {
-        return Err(FemError::InvalidInput(format!(
-            "force must be > 0 N, got {force_n}"
-        )));
-    }
+/// The bores of a rod mesh (loaded A, fixed B), the unit pin axis, and the F_x direction: along
+/// A→B, perpendicular to the pin axis. Shared by the static cases and [`rod_fx_case`].
+fn bores_and_direction(
+    mesh: &TetMesh,
+    bores: &BoreSpec,
+) -> Result<(BoreSurface, BoreSurface, [f64; 3], [f64; 3])> {
     let axis = bores.unit_axis()?;
     let boundary = boundary_faces(mesh)?;
     let (loaded, fixed) = find_bores(mesh, &boundary, bores)?;
@@ -460,7 +445,18 @@ pub fn rod_fx_case(mesh: &TetMesh, bores: &BoreSpec, force_n: f64) -> Result<Rod
             "the pin centres lie on one pin axis".into(),
         ));
     }
-    let ex = abp.map(|v| v / l);
+    Ok((loaded, fixed, axis, abp.map(|v| v / l)))
+}
+
+/// The F_x case of [`solve_rod_fields`] (the same bores, direction and nodal forces), for an
+/// analysis of that load other than the static one (buckling).
+pub fn rod_fx_case(mesh: &TetMesh, bores: &BoreSpec, force_n: f64) -> Result<RodFxCase> {
+    if !(force_n.is_finite() && force_n > 0.0) {
+        return Err(FemError::InvalidInput(format!(
+            "force must be > 0 N, got {force_n}"
+        )));
+    }
+    let (loaded, fixed, _, ex) = bores_and_direction(mesh, bores)?;
     let load = uniform_traction_with_resultant(mesh, &loaded.faces, ex.map(|v| v * force_n))?;
     let fixed_dofs = fixed
         .nodes
