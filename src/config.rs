@@ -31,13 +31,14 @@
 //! buckling_factor = 3.0         # the smallest accepted linear buckling load factor, judged
 //!                               # when buckling is computed (in the study: with a pressure trace)
 //!
-//! [cycle]             # stress over one revolution (inertia relief, fatigue)
-//! enabled = true
-//! instants = 360      # equally spaced, the first at crank angle 0
+//! [cycle]             # stress over one revolution (inertia relief, fatigue); with a pressure
+//! enabled = true      # trace over the four-stroke cycle (720°, the gas force on the piston)
+//! instants = 360      # per revolution, equally spaced, the first at crank angle 0
 //!
 //! [material]          # fatigue strengths (S355: EN 10025-2 minimum tensile strength; Shigley's
 //! ultimate_mpa = 470.0          # S'e = 0.5 Sut for steels, no Marin factors)
 //! endurance_mpa = 235.0
+//! mean_stress = "goodman"       # or "gerber": the mean-stress correction of the fatigue factor
 //!
 //! [engine]            # the mechanism around the rod (defaults: the thesis' test rig)
 //! crank_radius_mm = 46.0
@@ -50,6 +51,7 @@
 //! #                                    # (gauge); relative to this file's folder. None: no gas force
 //! ```
 
+use crate::fem::fatigue::MeanStress;
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Deserializer, Serialize};
 use std::path::{Path, PathBuf};
@@ -199,6 +201,10 @@ impl Default for CycleConfig {
 pub struct MaterialConfig {
     pub ultimate_mpa: f64,
     pub endurance_mpa: f64,
+    /// The mean-stress correction of the fatigue factor: `"goodman"` (default) or `"gerber"`
+    /// ([`crate::fem::fatigue::MeanStress`]); the default is not written into `results.json`.
+    #[serde(skip_serializing_if = "MeanStress::is_goodman")]
+    pub mean_stress: MeanStress,
 }
 
 impl Default for MaterialConfig {
@@ -206,6 +212,7 @@ impl Default for MaterialConfig {
         MaterialConfig {
             ultimate_mpa: 470.0,
             endurance_mpa: 235.0,
+            mean_stress: MeanStress::Goodman,
         }
     }
 }

@@ -90,9 +90,10 @@ pub fn run(args: CycleArgs) -> Result<i32> {
         );
     } else {
         println!(
-            "{}: {} instants over one revolution at {:.2} rad/s, mesh {} elements / {} DOFs",
+            "{}: {} instants over {} at {:.2} rad/s, mesh {} elements / {} DOFs",
             mass.design,
             cycle.instants,
+            crate::report::design_files::load_span(cycle.cycle_span_deg.is_some()),
             cycle.omega_rad_s,
             mesh.mesh.n_elements(),
             mesh.mesh.n_dofs()
@@ -106,7 +107,8 @@ pub fn run(args: CycleArgs) -> Result<i32> {
             cycle.location_of_max_mm[2]
         );
         println!(
-            "fatigue (Goodman, Se {:.0} / Sut {:.0} MPa): safety factor {:.2} at ({:.1}, {:.1}, {:.1}) mm, σa {:.2} MPa, σm {:.2} MPa",
+            "fatigue ({}, Se {:.0} / Sut {:.0} MPa): safety factor {:.2} at ({:.1}, {:.1}, {:.1}) mm, σa {:.2} MPa, σm {:.2} MPa",
+            if cycle.mean_stress.is_goodman() { "Goodman" } else { "Gerber" },
             cycle.endurance_mpa,
             cycle.ultimate_mpa,
             cycle.fatigue_safety_factor,

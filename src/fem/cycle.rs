@@ -26,7 +26,7 @@ use super::bores::{BoreSpec, find_bores};
 use super::boundary::boundary_faces;
 use super::element::QuadratureChoice;
 use super::error::{FemError, Result};
-use super::fatigue::{amplitude_and_mean, goodman_safety_factor, signed_von_mises};
+use super::fatigue::{MeanStress, amplitude_and_mean, signed_von_mises};
 use super::load::uniform_traction_with_resultant;
 use super::material::{Material, von_mises};
 use super::mesh::TetMesh;
@@ -69,9 +69,10 @@ pub struct CycleOptions {
     /// Sharp re-entrant edges (segments, m), and the band around them left out, m.
     pub singular_edges_m: Vec<[[f64; 3]; 2]>,
     pub singular_band_m: f64,
-    /// Endurance limit and ultimate strength, Pa (Goodman).
+    /// Endurance limit and ultimate strength, Pa, and the mean-stress correction.
     pub endurance_pa: f64,
     pub ultimate_pa: f64,
+    pub mean_stress: MeanStress,
     pub quadrature: QuadratureChoice,
 }
 
@@ -217,7 +218,8 @@ pub struct CycleSolution {
     pub history: Vec<CycleInstant>,
     /// Per node: max von Mises over the cycle (Pa).
     pub max_von_mises_pa: Vec<f64>,
-    /// Per node: Goodman safety factor of the signed von Mises cycle (∞ where unloaded).
+    /// Per node: the fatigue safety factor (Goodman or Gerber, [`CycleOptions::mean_stress`]) of
+    /// the signed von Mises cycle (∞ where unloaded).
     pub fatigue_safety_factor: Vec<f64>,
     /// Per node: alternating and mean signed von Mises (Pa).
     pub alternating_pa: Vec<f64>,
@@ -232,7 +234,7 @@ pub struct CycleSolution {
 }
 
 /// Combines the unit solutions over `instants`: per instant the judged maximum and the reaction,
-/// per node the maximum over the cycle and the Goodman factor of its signed von Mises cycle.
+/// per node the maximum over the cycle and the fatigue safety factor of its signed von Mises cycle.
 pub fn combine(
     units: &UnitSolutions,
     instants: &[RodFrameInstant],
@@ -314,7 +316,7 @@ pub fn combine(
         let (sa, sm) = amplitude_and_mean(c.s_min, c.s_max);
         alternating.push(sa);
         mean.push(sm);
-        factor.push(goodman_safety_factor(
+        factor.push(options.mean_stress.safety_factor(
             sa,
             sm,
             options.endurance_pa,
@@ -361,6 +363,7 @@ mod tests {
             singular_band_m: 0.003,
             endurance_pa: 235e6,
             ultimate_pa: 470e6,
+            mean_stress: MeanStress::Goodman,
             quadrature: QuadratureChoice::Auto,
         }
     }
@@ -494,7 +497,12 @@ mod tests {
         assert!(cycle.max_von_mises_pa[n] >= vm - 1e-6);
         // the fatigue factor of the critical node from its own alternating and mean stress
         let f = cycle.fatigue_node;
-        let expect = goodman_safety_factor(cycle.alternating_pa[f], cycle.mean_pa[f], 235e6, 470e6);
+        let expect = super::super::fatigue::goodman_safety_factor(
+            cycle.alternating_pa[f],
+            cycle.mean_pa[f],
+            235e6,
+            470e6,
+        );
         assert_eq!(cycle.fatigue_safety_factor[f], expect);
         assert!(expect.is_finite() && expect > 0.0);
     }

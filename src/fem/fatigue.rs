@@ -14,8 +14,51 @@
 //! **Goodman.** n = 1 / (σ_a / S_e + σ_m / S_ut) for σ_m ≥ 0; for a compressive mean the mean stress
 //! is taken as not helping, n = S_e / σ_a (R. G. Budynas, J. K. Nisbett, *Shigley's Mechanical
 //! Engineering Design*, 10th ed., §6-12, eqs. 6-46 and the compressive-mean branch of Table 6-6).
+//!
+//! **Gerber** (`[material] mean_stress = "gerber"`): the parabola n σ_a/S_e + (n σ_m/S_ut)² = 1,
+//! solved for the load line through (σ_m, σ_a):
+//! n = ½ (S_ut/σ_m)² (σ_a/S_e) [−1 + √(1 + (2 σ_m S_e / (S_ut σ_a))²)] for σ_m > 0 (Shigley,
+//! 10th ed., Table 6-7); compressive means as with Goodman. Gerber lies above the Goodman line
+//! (n_Gerber ≥ n_Goodman) and fits ductile steels' test data better; Goodman is the conservative
+//! default.
+
+use serde::{Deserialize, Serialize};
 
 use super::material::von_mises;
+
+/// The mean-stress correction of the fatigue safety factor.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MeanStress {
+    /// The Goodman line (the default).
+    #[default]
+    Goodman,
+    /// The Gerber parabola.
+    Gerber,
+}
+
+impl MeanStress {
+    /// Whether this is the default (Goodman), e.g. to leave it out of written settings.
+    pub fn is_goodman(&self) -> bool {
+        *self == MeanStress::Goodman
+    }
+
+    /// The safety factor of alternating `sa` and mean `sm` against `se` and `sut`.
+    pub fn safety_factor(self, sa: f64, sm: f64, se: f64, sut: f64) -> f64 {
+        match self {
+            MeanStress::Goodman => goodman_safety_factor(sa, sm, se, sut),
+            MeanStress::Gerber => gerber_safety_factor(sa, sm, se, sut),
+        }
+    }
+
+    /// The criterion's formula, for the reports.
+    pub fn formula(self) -> &'static str {
+        match self {
+            MeanStress::Goodman => "Goodman n = 1/(σa/Se + σm/Sut)",
+            MeanStress::Gerber => "Gerber n σa/Se + (n σm/Sut)² = 1",
+        }
+    }
+}
 
 /// The signed von Mises stress of a stress `[xx, yy, zz, xy, yz, zx]`: the von Mises stress with the
 /// sign of the trace (Bishop & Sherratt); `+` for a zero trace.
@@ -42,6 +85,21 @@ pub fn goodman_safety_factor(sa: f64, sm: f64, se: f64, sut: f64) -> f64 {
     } else {
         f64::INFINITY
     }
+}
+
+/// The Gerber safety factor (see the module documentation); for σ_m ≤ 0 as Goodman's.
+pub fn gerber_safety_factor(sa: f64, sm: f64, se: f64, sut: f64) -> f64 {
+    if sm <= 0.0 {
+        return goodman_safety_factor(sa, sm, se, sut);
+    }
+    if sa <= 0.0 {
+        // static tension: the parabola meets the σ_m axis at S_ut
+        return sut / sm;
+    }
+    let q = 2.0 * sm * se / (sut * sa);
+    // −1 + √(1 + q²) written without cancellation for small q: q² / (1 + √(1 + q²))
+    let root = q * q / (1.0 + (1.0 + q * q).sqrt());
+    0.5 * (sut / sm).powi(2) * (sa / se) * root
 }
 
 #[cfg(test)]
@@ -76,5 +134,39 @@ mod tests {
         assert_eq!((sa, sm), (100.0, 100.0));
         let n = goodman_safety_factor(sa, sm, se, sut);
         assert!((n - 1.0 / (100.0 / se + 100.0 / sut)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn gerber_parabola_and_its_limits() {
+        let (se, sut) = (235.0, 470.0);
+        // fully reversed and static: as Goodman
+        assert!((gerber_safety_factor(117.5, 0.0, se, sut) - 2.0).abs() < 1e-12);
+        assert!((gerber_safety_factor(0.0, 235.0, se, sut) - 2.0).abs() < 1e-12);
+        // a point on the parabola σa/Se + (σm/Sut)² = 1 has n = 1, scaled loads scale n
+        for sm in [10.0, 100.0, 300.0, 460.0] {
+            let sa = se * (1.0 - (sm / sut) * (sm / sut));
+            let n = gerber_safety_factor(sa, sm, se, sut);
+            assert!((n - 1.0).abs() < 1e-12, "σm {sm}: n = {n}");
+            let n2 = gerber_safety_factor(0.5 * sa, 0.5 * sm, se, sut);
+            // n σa/Se + (n σm/Sut)² = 1 at half the load
+            let g = n2 * 0.5 * sa / se + (n2 * 0.5 * sm / sut).powi(2);
+            assert!((g - 1.0).abs() < 1e-12, "{g}");
+            assert!(n2 > 2.0 * 0.999);
+            // Gerber credits more than Goodman
+            assert!(n2 >= goodman_safety_factor(0.5 * sa, 0.5 * sm, se, sut));
+        }
+        // compressive mean: as Goodman
+        assert_eq!(
+            gerber_safety_factor(117.5, -200.0, se, sut),
+            goodman_safety_factor(117.5, -200.0, se, sut)
+        );
+        assert_eq!(
+            MeanStress::Gerber.safety_factor(50.0, 80.0, se, sut),
+            gerber_safety_factor(50.0, 80.0, se, sut)
+        );
+        assert_eq!(
+            MeanStress::Goodman.safety_factor(50.0, 80.0, se, sut),
+            goodman_safety_factor(50.0, 80.0, se, sut)
+        );
     }
 }

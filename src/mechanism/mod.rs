@@ -89,7 +89,7 @@ pub use gas::{GasForce, PressureTrace, piston_area_m2};
 pub use linkage::{CrankSliderLinkage, LinkageJoint};
 pub use motion::{CrankMotion, MotionSample};
 pub use peak::{PeakRefinement, refine_max_of, refine_peak, wrap_degrees, wrap_degrees_to};
-pub use rod_cycle::{RodFrameInstant, acceleration_of, rod_frame_cycle};
+pub use rod_cycle::{RodFrameInstant, acceleration_of, rod_frame_cycle, rod_frame_engine_cycle};
 pub use scene::{
     Agreement, AxialPeaks, DrivenResult, DrivenScene, Method, compare_results, driven_scene,
     driven_scene_with_gas,

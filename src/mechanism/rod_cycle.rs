@@ -54,7 +54,8 @@ use super::closed_form::kinematics;
 use super::crank_slider::{CrankSlider, MechanismParams, RodInertia};
 use super::error::{DynamicsError, Result, positive};
 use super::motion::MotionSample;
-use super::peak::wrap_degrees;
+use super::gas::{CYCLE_DEG, GasForce};
+use super::peak::wrap_degrees_to;
 use super::scene::MAX_STEPS;
 
 /// One instant, every vector in the rod frame: origin at A (crank pin
@@ -62,7 +63,8 @@ use super::scene::MAX_STEPS;
 /// ŷ = ẑ × x̂ (global +y at top dead centre). SI units.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RodFrameInstant {
-    /// φ in [0, 360) degrees, φ = ω t, 0 = top dead centre.
+    /// φ in [0, 360) degrees (in [0, 720) over the four-stroke cycle), φ = ω t, 0 = (firing) top
+    /// dead centre.
     pub crank_angle_deg: f64,
     /// Time t (s).
     pub time_s: f64,
@@ -80,6 +82,9 @@ pub struct RodFrameInstant {
     /// Force BY the piston pin ON the rod at B (= −F_B of
     /// [`DrivenResult`](super::scene::DrivenResult), rotated), rod frame (N).
     pub f_b_on_rod_n: [f64; 2],
+    /// The gas force on the piston at this instant, N (towards the crank; 0 without a trace).
+    #[serde(default)]
+    pub gas_force_n: f64,
 }
 
 /// Acceleration of the rod point at rod-frame position `r` (m, from A),
@@ -108,19 +113,40 @@ pub fn rod_frame_cycle(
     omega_rad_s: f64,
     instants: usize,
 ) -> Result<Vec<RodFrameInstant>> {
+    rod_frame_engine_cycle(params, rod, omega_rad_s, instants, None)
+}
+
+/// The engine's load cycle in the rod frame: with a gas force ([`GasForce`], issue 20 item 5) the
+/// four-stroke cycle, 2 × `instants_per_revolution` equally spaced instants over 720° (φ_k = ω t_k,
+/// t_k = (4π/ω)·k/(2n)), the gas force F_gas(φ_k) acting on the piston along global −x (towards the
+/// crank), so that F_B,x(global) = m₄ (ẍ_B − g_x) − F_p + F_gas(φ) as in the closed form
+/// ([`CrankSlider::closed_form`]) and crank angles in [0, 720); without one exactly
+/// [`rod_frame_cycle`] (one revolution, angles in [0, 360)).
+pub fn rod_frame_engine_cycle(
+    params: &MechanismParams,
+    rod: &RodInertia,
+    omega_rad_s: f64,
+    instants_per_revolution: usize,
+    gas: Option<&GasForce>,
+) -> Result<Vec<RodFrameInstant>> {
     let model = CrankSlider::new(params, rod)?;
     let omega = positive("omega_rad_s", omega_rad_s)?;
-    if instants == 0 || instants > MAX_STEPS {
+    if instants_per_revolution == 0 || instants_per_revolution > MAX_STEPS {
         return Err(DynamicsError::InvalidScene(format!(
-            "instants per revolution must be between 1 and {MAX_STEPS}, got {instants}"
+            "instants per revolution must be between 1 and {MAX_STEPS}, got {instants_per_revolution}"
         )));
     }
+    let (revolutions, period_deg) = match gas {
+        Some(_) => (2usize, CYCLE_DEG),
+        None => (1usize, 360.0),
+    };
+    let instants = revolutions * instants_per_revolution;
     let p = model.params();
     let (r, l) = (p.crank_radius_m, p.centre_distance_m);
     let (m3, i3, m4) = (rod.mass_kg, rod.i_zz_kgm2, p.piston_mass_kg);
     let r_g = Vector2::new(rod.l1_m, rod.offset_m);
     let g_global = p.gravity_vector();
-    let period = std::f64::consts::TAU / omega;
+    let period = revolutions as f64 * std::f64::consts::TAU / omega;
     let mut out = Vec::with_capacity(instants);
     for k in 0..instants {
         let t = period * (k as f64) / (instants as f64);
@@ -146,12 +172,13 @@ pub fn rod_frame_cycle(
         // moment about A: l Q_y = I α₃ + r_G × m (a_G − g)
         let q_y = (i3 * al3 + r_g.x * net.y - r_g.y * net.x) / l;
         // piston, global x: F_B,x = m₄ (ẍ_B − g_x) − F_p; Q·x̂_global = −F_B,x
-        let f_bx = m4 * (kin.xdd_b - g_global.x) - p.piston_force_n;
+        let f_gas = gas.map_or(0.0, |g| g.at(m.phi));
+        let f_bx = m4 * (kin.xdd_b - g_global.x) - p.piston_force_n + f_gas;
         let q_x = (-f_bx - q_y * sp) / cp;
         let q = Vector2::new(q_x, q_y);
         let f_a = net - q;
         let inst = RodFrameInstant {
-            crank_angle_deg: wrap_degrees(m.phi),
+            crank_angle_deg: wrap_degrees_to(m.phi, period_deg),
             time_s: t,
             a_a_m_s2: [a_a.x, a_a.y],
             omega3_rad_s: w3,
@@ -159,6 +186,7 @@ pub fn rod_frame_cycle(
             gravity_m_s2: [g.x, g.y],
             f_a_on_rod_n: [f_a.x, f_a.y],
             f_b_on_rod_n: [q.x, q.y],
+            gas_force_n: f_gas,
         };
         let finite = [w3, al3, a_a.x, a_a.y, f_a.x, f_a.y, q.x, q.y]
             .iter()
@@ -176,8 +204,9 @@ pub fn rod_frame_cycle(
 
 #[cfg(test)]
 mod tests {
-    use super::super::scene::{DrivenScene, Method, driven_scene};
+    use super::super::scene::{DrivenScene, Method, driven_scene, driven_scene_with_gas};
     use super::*;
+    use std::sync::Arc;
 
     const OMEGA: f64 = 40.0 * std::f64::consts::PI;
 
@@ -245,6 +274,66 @@ mod tests {
             eprintln!("driven_scene agreement: F_A {ea:.2e}, F_B {eb:.2e} (rel. to peak)");
             assert!(ea < 1e-9 && eb < 1e-9, "F_A {ea:e}, F_B {eb:e}");
         }
+    }
+
+    /// A trace in miniature: a firing peak of 60 bar 12° after firing top dead centre, a little
+    /// pressure elsewhere, on an 82 mm bore.
+    fn test_gas() -> GasForce {
+        let trace = super::super::gas::PressureTrace::parse(
+            "crank_angle_deg,pressure_bar\n0,30\n12,60\n60,8\n180,1\n360,0.2\n540,0.5\n690,12\n720,30\n",
+        )
+        .expect("trace");
+        GasForce::from_trace(&trace, 0.082)
+    }
+
+    #[test]
+    fn with_a_gas_force_the_cycle_spans_720_degrees_and_agrees_with_the_closed_form() {
+        let n = 180;
+        let gas = Arc::new(test_gas());
+        for (p, rod) in cases() {
+            let cyc = rod_frame_engine_cycle(&p, &rod, OMEGA, n, Some(&gas)).expect("cycle");
+            assert_eq!(cyc.len(), 2 * n);
+            assert_eq!(cyc[0].crank_angle_deg, 0.0);
+            assert!((cyc[n].crank_angle_deg - 360.0).abs() < 1e-9);
+            assert!(cyc.iter().all(|i| (0.0..720.0).contains(&i.crank_angle_deg)));
+            let scene = DrivenScene {
+                omega_rad_s: OMEGA,
+                duration_s: 2.0 * std::f64::consts::TAU / OMEGA,
+                steps: 2 * n,
+                phi0_rad: 0.0,
+            };
+            let d = driven_scene_with_gas(&p, &rod, Some(Arc::clone(&gas)), &scene, Method::ClosedForm)
+                .expect("scene");
+            let peak_a = d.fa_abs_n.iter().fold(0.0f64, |a, b| a.max(*b));
+            let peak_b = d.fb_abs_n.iter().fold(0.0f64, |a, b| a.max(*b));
+            let (mut ea, mut eb, mut eg) = (0.0f64, 0.0f64, 0.0f64);
+            let gas_n = d.gas_force_n.as_ref().expect("gas force samples");
+            for (k, inst) in cyc.iter().enumerate() {
+                assert!((inst.time_s - d.t_s[k]).abs() <= 1e-15 * d.t_s[k].max(1.0));
+                let psi = psi_at(&p, inst.time_s);
+                let fa = rotate_to_global(psi, inst.f_a_on_rod_n);
+                let fb = rotate_to_global(psi, inst.f_b_on_rod_n);
+                ea = ea.max((fa - Vector2::new(d.fa_x_n[k], d.fa_y_n[k])).norm() / peak_a);
+                eb = eb.max((fb + Vector2::new(d.fb_x_n[k], d.fb_y_n[k])).norm() / peak_b);
+                eg = eg.max((inst.gas_force_n - gas_n[k]).abs() / gas.max_n());
+            }
+            eprintln!("engine cycle vs closed form: F_A {ea:.2e}, F_B {eb:.2e}, F_gas {eg:.2e}");
+            assert!(ea < 1e-9 && eb < 1e-9 && eg < 1e-12, "F_A {ea:e}, F_B {eb:e}");
+            // the gas force matters here: the firing peak is several times the inertia peak
+            let no_gas = rod_frame_cycle(&p, &rod, OMEGA, n).expect("cycle");
+            let peak = |c: &[RodFrameInstant]| {
+                c.iter()
+                    .map(|i| i.f_a_on_rod_n[0].hypot(i.f_a_on_rod_n[1]))
+                    .fold(0.0f64, f64::max)
+            };
+            assert!(peak(&cyc) > 2.0 * peak(&no_gas), "{} vs {}", peak(&cyc), peak(&no_gas));
+        }
+        // without a gas force: exactly the one-revolution cycle
+        let (p, rod) = &cases()[0];
+        assert_eq!(
+            rod_frame_engine_cycle(p, rod, OMEGA, 90, None).expect("cycle"),
+            rod_frame_cycle(p, rod, OMEGA, 90).expect("cycle")
+        );
     }
 
     #[test]

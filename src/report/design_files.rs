@@ -33,14 +33,26 @@ pub fn histories(results: &StudyResults) -> Vec<(String, String, &DrivenResult)>
 
 /// The points of one history over its first crank revolution: (φ − φ₀ [°], value).
 fn first_turn(h: &DrivenResult, value: impl Fn(usize) -> f64) -> Vec<(f64, f64)> {
-    let turn = std::f64::consts::TAU;
+    // the loads' period: one revolution, or the four-stroke cycle with a gas force
+    let turns = if h.gas_force_n.is_some() { 2.0 } else { 1.0 };
+    let span = turns * std::f64::consts::TAU;
     (0..h.t_s.len())
-        .take_while(|&k| h.phi_rad[k] - h.phi_rad[0] <= turn + 1e-9)
+        .take_while(|&k| h.phi_rad[k] - h.phi_rad[0] <= span + 1e-9)
         .map(|k| ((h.phi_rad[k] - h.phi_rad[0]).to_degrees(), value(k)))
         .collect()
 }
 
-/// One design's pin force over the first revolution: |F_A| and its components.
+/// "one revolution", or with a gas force "the four-stroke cycle (720°)": the span of the loads.
+pub fn load_span(with_gas: bool) -> &'static str {
+    if with_gas {
+        "the four-stroke cycle (720°)"
+    } else {
+        "one revolution"
+    }
+}
+
+/// One design's pin force over the first revolution (the four-stroke cycle with a gas force):
+/// |F_A| and its components.
 pub fn design_pin_force_plot(design: &str, h: &DrivenResult) -> Result<String> {
     let series = vec![
         plots::Series {
@@ -75,8 +87,12 @@ pub fn pin_force_plot(histories: &[(String, String, &DrivenResult)]) -> Result<S
             points: first_turn(h, |k| h.fa_abs_n[k]),
         })
         .collect();
+    let with_gas = histories.iter().any(|(_, _, h)| h.gas_force_n.is_some());
     plots::line_chart(
-        "Crank–rod pin force over one revolution (φ = 40πt, gravity on)",
+        &format!(
+            "Crank–rod pin force over {} (φ = 40πt, gravity on)",
+            load_span(with_gas)
+        ),
         "crank angle φ [°] (0 = top dead centre)",
         "|F_A| [N]",
         &series,
@@ -117,7 +133,8 @@ pub fn cycle_csv(c: &DesignCycle) -> Result<Vec<u8>> {
     Ok(w.into_inner()?)
 }
 
-/// `cycle.svg` of one design: the judged max von Mises over one revolution.
+/// `cycle.svg` of one design: the judged max von Mises over one revolution (or the four-stroke
+/// cycle).
 pub fn cycle_plot(design: &str, c: &DesignCycle) -> Result<String> {
     let series = vec![plots::Series {
         name: "max von Mises".into(),
@@ -128,7 +145,10 @@ pub fn cycle_plot(design: &str, c: &DesignCycle) -> Result<String> {
             .collect(),
     }];
     plots::line_chart(
-        &format!("{design}: max von Mises over one revolution (inertia relief)"),
+        &format!(
+            "{design}: max von Mises over {} (inertia relief)",
+            load_span(c.cycle_span_deg.is_some())
+        ),
         "crank angle φ [°] (0 = top dead centre)",
         "max von Mises away from the fixed bore [MPa]",
         &series,

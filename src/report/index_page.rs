@@ -6,6 +6,7 @@
 //!
 //! Self-contained for `file://`: relative links only, no scripts, no fonts or styles fetched.
 
+use super::design_files::load_span;
 use super::file_safe;
 use super::ranking::{self, RankRow, Status, escape};
 use crate::study::results::StudyResults;
@@ -83,7 +84,10 @@ pub fn index_html(results: &StudyResults, out: &Path) -> String {
             &mut s,
             out,
             "pin_force.svg",
-            "|F_A| over one revolution, every design",
+            &format!(
+                "|F_A| over {}, every design",
+                load_span(results.config.engine.pressure_trace.is_some())
+            ),
         );
         image(
             &mut s,
@@ -232,7 +236,11 @@ fn design_section(s: &mut String, r: &RankRow, out: &Path) {
     }
     if let Some(c) = r.cycle {
         props.push((
-            "cycle (one revolution, inertia relief)",
+            if c.cycle_span_deg.is_some() {
+                "cycle (four-stroke, 720°, gas force and inertia relief)"
+            } else {
+                "cycle (one revolution, inertia relief)"
+            },
             format!(
                 "max von Mises {:.2} MPa at φ = {:.0}°, at ({:.1}, {:.1}, {:.1}) mm; reaction at B equals the dynamics' F_B to {:.1e} of the peak pin force",
                 c.max_von_mises_over_cycle_mpa,
@@ -244,7 +252,11 @@ fn design_section(s: &mut String, r: &RankRow, out: &Path) {
             ),
         ));
         props.push((
-            "fatigue (Goodman, signed von Mises)",
+            if c.mean_stress.is_goodman() {
+                "fatigue (Goodman, signed von Mises)"
+            } else {
+                "fatigue (Gerber, signed von Mises)"
+            },
             format!(
                 "safety factor {:.2} at ({:.1}, {:.1}, {:.1}) mm: σa {:.2} MPa, σm {:.2} MPa against Se {:.0} / Sut {:.0} MPa",
                 c.fatigue_safety_factor,
@@ -267,7 +279,10 @@ fn design_section(s: &mut String, r: &RankRow, out: &Path) {
         s,
         out,
         &format!("{dir}/pin_force.svg"),
-        "|F_A| and its components over one revolution",
+        &format!(
+            "|F_A| and its components over {}",
+            load_span(r.dynamics.is_some_and(|d| d.peak_compression_n.is_some()))
+        ),
     );
     if let Some(f) = r.fem {
         for case in [&f.fem.fx, &f.fem.fy] {
@@ -294,7 +309,10 @@ fn design_section(s: &mut String, r: &RankRow, out: &Path) {
             s,
             out,
             &format!("{dir}/von_mises_cycle.svg"),
-            "max von Mises over one revolution at every point (quasi-static, inertia relief); the marked point is the judged maximum",
+            &format!(
+                "max von Mises over {} at every point (quasi-static, inertia relief); the marked point is the judged maximum",
+                load_span(r.cycle.is_some_and(|c| c.cycle_span_deg.is_some()))
+            ),
         );
         image(
             s,

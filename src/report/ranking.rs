@@ -183,6 +183,16 @@ struct CsvRow<'a> {
     i_zz_kgm2: f64,
     i_xx_kgm2: f64,
     peak_pin_force_n: Option<f64>,
+    /// With a pressure trace: the largest compression and tension along the rod axis (N, as
+    /// magnitudes) and their crank angles in [0, 720) degrees (columns only in the engine study).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    peak_compression_n: Option<Option<f64>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    peak_compression_crank_angle_deg: Option<Option<f64>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    peak_tension_n: Option<Option<f64>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    peak_tension_crank_angle_deg: Option<Option<f64>>,
     fx_von_mises_away_from_fixed_mpa: Option<f64>,
     fx_estimated_error_rel: Option<f64>,
     fx_von_mises_averaged_mpa: Option<f64>,
@@ -191,8 +201,8 @@ struct CsvRow<'a> {
     fy_estimated_error_rel: Option<f64>,
     fy_von_mises_averaged_mpa: Option<f64>,
     fy_von_mises_unaveraged_mpa: Option<f64>,
-    /// The cycle stage: max von Mises over one revolution (inertia relief), its crank angle, and
-    /// the smallest Goodman fatigue safety factor.
+    /// The cycle stage: max von Mises over one revolution (the four-stroke cycle with a trace;
+    /// inertia relief), its crank angle, and the smallest fatigue safety factor.
     cycle_max_von_mises_mpa: Option<f64>,
     cycle_crank_angle_of_max_deg: Option<f64>,
     fatigue_safety_factor: Option<f64>,
@@ -218,8 +228,10 @@ struct CsvRow<'a> {
 pub fn csv(results: &StudyResults) -> Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
     let buckling = has_buckling(results);
+    let engine = has_engine_loads(results);
     for r in ranking(results) {
         let f = r.fem;
+        let d = r.dynamics;
         let fx = f.map(|f| &f.fem.fx);
         let fy = f.map(|f| &f.fem.fy);
         w.serialize(CsvRow {
@@ -231,6 +243,12 @@ pub fn csv(results: &StudyResults) -> Result<Vec<u8>> {
             i_zz_kgm2: r.mass.i_zz_kgm2,
             i_xx_kgm2: r.mass.i_xx_kgm2,
             peak_pin_force_n: r.peak_force_n(),
+            peak_compression_n: engine.then(|| d.and_then(|d| d.peak_compression_n)),
+            peak_compression_crank_angle_deg: engine
+                .then(|| d.and_then(|d| d.peak_compression_crank_angle_deg)),
+            peak_tension_n: engine.then(|| d.and_then(|d| d.peak_tension_n)),
+            peak_tension_crank_angle_deg: engine
+                .then(|| d.and_then(|d| d.peak_tension_crank_angle_deg)),
             fx_von_mises_away_from_fixed_mpa: fx.map(|c| c.max_von_mises_away_from_fixed_mpa),
             fx_estimated_error_rel: fx.map(|c| c.estimated_error_rel),
             fx_von_mises_averaged_mpa: fx.map(|c| c.max_von_mises_averaged_mpa),
@@ -297,20 +315,78 @@ pub const BUCKLING_HEADER: &str = "buckling load factor";
 /// Columns of [`HEADERS`] before the buckling column (after the fatigue safety factor).
 pub const BUCKLING_AFTER: usize = 8;
 
-/// The headers of the study's table: [`HEADERS`], with the buckling column when any design has a
-/// buckling load factor.
+/// Whether any design has the engine's axial peaks (a study with a pressure trace): then the
+/// tables get the peak compression and tension columns after the peak pin force.
+pub fn has_engine_loads(results: &StudyResults) -> bool {
+    results.designs.iter().any(|d| {
+        d.dynamics.peak_compression_n.is_some()
+    })
+}
+
+/// The headers of the engine columns, placed after [`ENGINE_AFTER`] columns of [`HEADERS`].
+pub const ENGINE_HEADERS: [&str; 2] = ["peak compression [N] at φ", "peak tension [N] at φ"];
+/// Columns of [`HEADERS`] before the engine columns (after the peak pin force).
+pub const ENGINE_AFTER: usize = 9;
+
+/// The optional columns of the study's table.
+#[derive(Clone, Copy, Debug)]
+pub struct TableColumns {
+    /// The buckling load factor ([`has_buckling`]).
+    pub buckling: bool,
+    /// Peak compression and tension ([`has_engine_loads`]).
+    pub engine: bool,
+}
+
+impl TableColumns {
+    pub fn of(results: &StudyResults) -> TableColumns {
+        TableColumns {
+            buckling: has_buckling(results),
+            engine: has_engine_loads(results),
+        }
+    }
+}
+
+/// The headers of the study's table: [`HEADERS`], with the engine columns and the buckling
+/// column when any design has them.
 pub fn table_headers(results: &StudyResults) -> Vec<&'static str> {
+    let cols = TableColumns::of(results);
     let mut h = HEADERS.to_vec();
-    if has_buckling(results) {
+    if cols.engine {
+        for (k, e) in ENGINE_HEADERS.iter().enumerate() {
+            h.insert(ENGINE_AFTER + k, e);
+        }
+    }
+    if cols.buckling {
         h.insert(BUCKLING_AFTER, BUCKLING_HEADER);
     }
     h
 }
 
 /// The cells of one row in [`table_headers`] order.
-pub fn table_cells(r: &RankRow, buckling: bool) -> Vec<String> {
+pub fn table_cells(r: &RankRow, cols: TableColumns) -> Vec<String> {
     let mut c = cells(r).to_vec();
-    if buckling {
+    if cols.engine {
+        let peak = |n: Option<f64>, at: Option<f64>| match (n, at) {
+            (Some(n), Some(at)) => format!("{n:.0} at {at:.0}°"),
+            _ => "—".to_string(),
+        };
+        let d = r.dynamics;
+        c.insert(
+            ENGINE_AFTER,
+            peak(
+                d.and_then(|d| d.peak_compression_n),
+                d.and_then(|d| d.peak_compression_crank_angle_deg),
+            ),
+        );
+        c.insert(
+            ENGINE_AFTER + 1,
+            peak(
+                d.and_then(|d| d.peak_tension_n),
+                d.and_then(|d| d.peak_tension_crank_angle_deg),
+            ),
+        );
+    }
+    if cols.buckling {
         c.insert(
             BUCKLING_AFTER,
             r.fem
@@ -399,8 +475,18 @@ pub fn explanation(results: &StudyResults) -> String {
         },
         if c.fatigue && !results.stages_skipped.iter().any(|s| s == "cycle") {
             format!(
-                "; and a Goodman fatigue safety factor ≥ {} over one revolution with inertia relief, Se {} / Sut {} MPa",
+                "; and a {} fatigue safety factor ≥ {} over {} with inertia relief, Se {} / Sut {} MPa",
+                if results.config.material.mean_stress.is_goodman() {
+                    "Goodman"
+                } else {
+                    "Gerber"
+                },
                 c.fatigue_safety_factor,
+                if results.config.engine.pressure_trace.is_some() {
+                    "the four-stroke cycle (720°, with the gas force)"
+                } else {
+                    "one revolution"
+                },
                 results.config.material.endurance_mpa,
                 results.config.material.ultimate_mpa
             )
@@ -438,11 +524,11 @@ pub const VALIDITY_PREAMBLE: &str = "The stage-3 model is linear elastic and sma
 pub fn markdown(results: &StudyResults) -> String {
     let mut out = format!("# Ranking of the designs\n\n{}\n\n", explanation(results));
     let headers = table_headers(results);
-    let buckling = has_buckling(results);
+    let cols = TableColumns::of(results);
     out.push_str(&format!("| {} |\n", headers.join(" | ")));
     out.push_str(&format!("|{}\n", "---|".repeat(headers.len())));
     for r in ranking(results) {
-        let cells: Vec<String> = table_cells(&r, buckling)
+        let cells: Vec<String> = table_cells(&r, cols)
             .into_iter()
             .map(|c| c.replace('|', "\\|"))
             .collect();
@@ -481,7 +567,7 @@ pub fn escape(s: &str) -> String {
 /// ranking order); the design names link to their sections (`#<id>`).
 pub fn html_table(results: &StudyResults) -> String {
     let mut out = String::from("<table id=\"ranking\">\n<thead><tr>");
-    let buckling = has_buckling(results);
+    let cols = TableColumns::of(results);
     for h in table_headers(results) {
         out.push_str(&format!("<th>{}</th>", escape(h)));
     }
@@ -492,7 +578,7 @@ pub fn html_table(results: &StudyResults) -> String {
             "<tr data-id=\"{id}\" class=\"{}\">",
             r.status.class()
         ));
-        for (k, c) in table_cells(&r, buckling).iter().enumerate() {
+        for (k, c) in table_cells(&r, cols).iter().enumerate() {
             let c = escape(c);
             if k == 1 {
                 out.push_str(&format!("<td><a href=\"#{id}\">{c}</a></td>"));

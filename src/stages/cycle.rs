@@ -1,8 +1,12 @@
 //! The cycle stage for one design: stress over one crank revolution on stage 3's mesh, with
-//! inertia relief, and the Goodman fatigue safety factor (see [`crate::fem::cycle`]).
+//! inertia relief, and the fatigue safety factor (see [`crate::fem::cycle`]). With a cylinder
+//! pressure trace (`[engine] pressure_trace`, issue 20 item 5) the cycle is the engine's
+//! four-stroke cycle: 720°, the gas force on the piston at each instant
+//! ([`rod_frame_engine_cycle`]), so the worst instant and the fatigue factor come from the firing
+//! loads and the inertia together.
 //!
-//! Loads and kinematics come from the driven scene's mechanism at the study's crank speed, gravity
-//! on, evaluated with the **mesh's** mass properties (mass, centroid, I_zz from the tet10 mesh with
+//! Loads and kinematics come from the configured engine's mechanism at the study's crank speed,
+//! gravity on, evaluated with the **mesh's** mass properties (mass, centroid, I_zz from the tet10 mesh with
 //! the design's density), so that the reaction at the fixed bore B equals the piston pin's force
 //! F_B of the dynamics at every instant; the stage reports how far those properties are from the
 //! STL's exact ones.
@@ -13,13 +17,32 @@ use crate::fem::QuadratureChoice;
 use crate::fem::cycle::{
     CycleOptions, CycleSolution, UnitSolutions, combine, rod_inertia_of, unit_solutions,
 };
+use crate::fem::fatigue::MeanStress;
 use crate::fem::material::Material;
-use crate::mechanism::rod_frame_cycle;
+use crate::mechanism::rod_frame_engine_cycle;
 use anyhow::{Context, Result};
 use std::time::Instant;
 
-/// How the mean and alternating stresses are formed (reported as `method`).
+/// How the mean and alternating stresses are formed (reported as `method`), for the default
+/// setting: one revolution, Goodman.
 pub const FATIGUE_METHOD: &str = "signed von Mises (sign of the hydrostatic stress; Bishop & Sherratt, NAFEMS 2000) per node over one revolution: σa = (max − min)/2, σm = (max + min)/2; Goodman n = 1/(σa/Se + σm/Sut), compressive mean not credited (Shigley §6-12)";
+
+/// The `method` text for a cycle over `span_deg` (360 or 720) with the `mean_stress` correction
+/// ([`FATIGUE_METHOD`] for the default).
+pub fn fatigue_method(span_deg: f64, mean_stress: MeanStress) -> String {
+    if span_deg == 360.0 && mean_stress.is_goodman() {
+        return FATIGUE_METHOD.into();
+    }
+    let cycle = if span_deg == 360.0 {
+        "one revolution".to_string()
+    } else {
+        format!("the four-stroke cycle ({span_deg:.0}°, with the gas force)")
+    };
+    format!(
+        "signed von Mises (sign of the hydrostatic stress; Bishop & Sherratt, NAFEMS 2000) per node over {cycle}: σa = (max − min)/2, σm = (max + min)/2; {}, compressive mean not credited (Shigley §6-12, Table 6-7)",
+        mean_stress.formula()
+    )
+}
 
 /// The cycle stage's record and the fields it was formed from (for the report's `cycle.vtu` and
 /// picture).
@@ -41,18 +64,22 @@ pub fn cycle(mass: &DesignMass, mesh: &StageMesh, config: &StudyConfig) -> Resul
         singular_band_m: mesh.singular_band_m,
         endurance_pa: config.material.endurance_mpa * 1e6,
         ultimate_pa: config.material.ultimate_mpa * 1e6,
+        mean_stress: config.material.mean_stress,
         quadrature: QuadratureChoice::Auto,
     };
     let units =
         unit_solutions(&mesh.mesh, &material, &mesh.bores, &options).with_context(context)?;
-    let params = super::dynamics::mechanism_for(mass, true);
-    let instants = rod_frame_cycle(
+    let params = super::dynamics::engine_mechanism_for(mass, &config.engine, true);
+    let gas = config.engine.gas_force().with_context(context)?;
+    let instants = rod_frame_engine_cycle(
         &params,
         &rod_inertia_of(&units.mass),
         config.driven.omega_rad_s,
         config.cycle.instants,
+        gas.as_deref(),
     )
     .with_context(context)?;
+    let span_deg = if gas.is_some() { 720.0 } else { 360.0 };
     let cycle = combine(&units, &instants, &options).with_context(context)?;
     let analysis_seconds = start.elapsed().as_secs_f64();
     let nodes = mesh.mesh.nodes();
@@ -67,7 +94,7 @@ pub fn cycle(mass: &DesignMass, mesh: &StageMesh, config: &StudyConfig) -> Resul
         fatigue_location_mm: mm(f),
         fatigue_alternating_mpa: cycle.alternating_pa[f] * 1e-6,
         fatigue_mean_mpa: cycle.mean_pa[f] * 1e-6,
-        method: FATIGUE_METHOD.into(),
+        method: fatigue_method(span_deg, config.material.mean_stress),
         endurance_mpa: config.material.endurance_mpa,
         ultimate_mpa: config.material.ultimate_mpa,
         instants: instants.len(),
@@ -81,6 +108,11 @@ pub fn cycle(mass: &DesignMass, mesh: &StageMesh, config: &StudyConfig) -> Resul
             .map(|i| i.f_a_on_rod_n[0].hypot(i.f_a_on_rod_n[1]))
             .fold(0.0, f64::max),
         history: cycle.history.clone(),
+        cycle_span_deg: gas.is_some().then_some(span_deg),
+        peak_gas_force_n: gas
+            .is_some()
+            .then(|| instants.iter().map(|i| i.gas_force_n).fold(0.0, f64::max)),
+        mean_stress: config.material.mean_stress,
         vtu: None,
         picture: None,
         analysis_seconds,

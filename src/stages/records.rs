@@ -5,6 +5,7 @@
 
 use crate::fem::adapt::StopReason;
 use crate::fem::cycle::CycleInstant;
+use crate::fem::fatigue::MeanStress;
 use crate::fem::{BoreSpec, FemResult, TetMesh};
 use crate::mechanism::{Method, PeakSensitivity};
 use serde::{Deserialize, Serialize};
@@ -199,6 +200,15 @@ pub struct DesignCycle {
     pub reaction_mismatch_rel: f64,
     /// Largest |F_A| over the cycle with the mesh's mass properties, N.
     pub peak_pin_force_n: f64,
+    /// With a pressure trace: the cycle's span (720°, the four-stroke cycle) and the largest gas
+    /// force on the piston over it, N (absent without a trace: one revolution, no gas force).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cycle_span_deg: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_gas_force_n: Option<f64>,
+    /// The mean-stress correction of the fatigue factor (absent: Goodman).
+    #[serde(default, skip_serializing_if = "MeanStress::is_goodman")]
+    pub mean_stress: MeanStress,
     /// ParaView file (max-over-cycle von Mises, fatigue factor) and the picture.
     pub vtu: Option<PathBuf>,
     pub picture: Option<PathBuf>,
