@@ -21,6 +21,7 @@
 //! singular_band_mm = 3.0       # band around sharp re-entrant edges left out of it
 //! youngs_modulus_pa = 210e9
 //! poisson_ratio = 0.3
+//! bore_load = "uniform"        # or "cosine": a cosine bearing pressure on the pressed half
 //!
 //! [criterion]         # the ranking's stress criterion
 //! yield_mpa = 355.0
@@ -52,6 +53,7 @@
 //! ```
 
 use crate::fem::fatigue::MeanStress;
+use crate::fem::load::BoreLoad;
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Deserializer, Serialize};
 use std::path::{Path, PathBuf};
@@ -103,6 +105,11 @@ pub struct FemConfig {
     pub singular_band_mm: f64,
     pub youngs_modulus_pa: f64,
     pub poisson_ratio: f64,
+    /// How a pin's force is spread over its bore: `"uniform"` (default, the thesis' setting) or
+    /// `"cosine"` (a cosine bearing pressure on the half the pin presses on); the default is not
+    /// written into `results.json`.
+    #[serde(skip_serializing_if = "BoreLoad::is_uniform")]
+    pub bore_load: BoreLoad,
 }
 
 impl Default for FemConfig {
@@ -119,6 +126,7 @@ impl Default for FemConfig {
             singular_band_mm: 3.0,
             youngs_modulus_pa: 210e9,
             poisson_ratio: 0.3,
+            bore_load: BoreLoad::Uniform,
         }
     }
 }

@@ -108,7 +108,11 @@ pub fn run(args: CycleArgs) -> Result<i32> {
         );
         println!(
             "fatigue ({}, Se {:.0} / Sut {:.0} MPa): safety factor {:.2} at ({:.1}, {:.1}, {:.1}) mm, σa {:.2} MPa, σm {:.2} MPa",
-            if cycle.mean_stress.is_goodman() { "Goodman" } else { "Gerber" },
+            if cycle.mean_stress.is_goodman() {
+                "Goodman"
+            } else {
+                "Gerber"
+            },
             cycle.endurance_mpa,
             cycle.ultimate_mpa,
             cycle.fatigue_safety_factor,

@@ -17,6 +17,7 @@ use serde::{Deserialize, Serialize};
 
 use super::boundary::{BoundaryFace, dot, face_area, face_coords, face_normal, face_point, norm};
 use super::error::{FemError, Result};
+use super::load::BoreLoad;
 use super::mesh::TetMesh;
 use super::quadrature::TRI6;
 
@@ -42,6 +43,10 @@ pub struct BoreSpec {
     pub loaded_arc_deg: f64,
     #[serde(default = "full_arc")]
     pub fixed_arc_deg: f64,
+    /// How a pin's force is spread over its bore: uniform (default) or a cosine bearing
+    /// pressure on the pressed half ([`super::load::BoreLoad`], `[fem] bore_load`).
+    #[serde(default)]
+    pub bore_load: BoreLoad,
 }
 
 fn full_arc() -> f64 {
@@ -67,6 +72,7 @@ impl BoreSpec {
             min_coverage: 0.85,
             loaded_arc_deg: 360.0,
             fixed_arc_deg: 360.0,
+            bore_load: BoreLoad::Uniform,
         }
     }
 

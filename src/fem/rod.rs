@@ -17,7 +17,7 @@ use super::boundary::{boundary_faces, cross, norm};
 use super::element::QuadratureChoice;
 use super::error::{FemError, Result};
 use super::estimate::{ErrorEstimate, EstimateSummary, estimate_error};
-use super::load::uniform_traction_with_resultant;
+use super::load::{BoreLoad, pin_load};
 use super::material::Material;
 use super::mesh::TetMesh;
 use super::recovery::recover_stress;
@@ -199,6 +199,10 @@ pub struct FemResult {
     /// Band around them excluded from the judged peak, mm.
     #[serde(default)]
     pub singular_band_mm: f64,
+    /// How the pin force is spread over the loaded bore (absent: uniform; `cosine`: a cosine
+    /// bearing pressure on the pressed half).
+    #[serde(default, skip_serializing_if = "BoreLoad::is_uniform")]
+    pub bore_load: BoreLoad,
     /// The loaded bore.
     pub loaded_bore: BoreSummary,
     /// The fixed bore.
@@ -266,7 +270,16 @@ pub fn solve_rod_fields(
     let cases = [("fx", ex), ("fy", ey)];
     let loads = cases
         .iter()
-        .map(|(_, d)| uniform_traction_with_resultant(mesh, &loaded.faces, d.map(|v| v * force_n)))
+        .map(|(_, d)| {
+            pin_load(
+                mesh,
+                &loaded.faces,
+                bores.loaded_centre_m,
+                axis,
+                d.map(|v| v * force_n),
+                bores.bore_load,
+            )
+        })
         .collect::<Result<Vec<_>>>()?;
 
     let prescribed: Vec<(usize, f64)> = fixed
@@ -381,6 +394,7 @@ pub fn solve_rod_fields(
         fixed_band_mm: band * 1e3,
         singular_edges: options.singular_edges_m.len(),
         singular_band_mm: singular_band * 1e3,
+        bore_load: bores.bore_load,
         loaded_bore: (&loaded).into(),
         fixed_bore: (&fixed).into(),
         timings,
@@ -411,7 +425,8 @@ pub fn solve_rod_fields(
 }
 
 /// The F_x case of [`solve_rod`] as supports and nodal forces: bore B fixed (all DOFs of its
-/// nodes), the uniform traction of resultant `force_n` along A→B (perpendicular to the pin axis)
+/// nodes), the pin load (uniform or cosine, [`BoreSpec::bore_load`]) of resultant `force_n` along
+/// A→B (perpendicular to the pin axis)
 /// on bore A. Pushing A towards the fixed B, this case compresses the rod.
 #[derive(Clone, Debug)]
 pub struct RodFxCase {
@@ -456,8 +471,15 @@ pub fn rod_fx_case(mesh: &TetMesh, bores: &BoreSpec, force_n: f64) -> Result<Rod
             "force must be > 0 N, got {force_n}"
         )));
     }
-    let (loaded, fixed, _, ex) = bores_and_direction(mesh, bores)?;
-    let load = uniform_traction_with_resultant(mesh, &loaded.faces, ex.map(|v| v * force_n))?;
+    let (loaded, fixed, axis, ex) = bores_and_direction(mesh, bores)?;
+    let load = pin_load(
+        mesh,
+        &loaded.faces,
+        bores.loaded_centre_m,
+        axis,
+        ex.map(|v| v * force_n),
+        bores.bore_load,
+    )?;
     let fixed_dofs = fixed
         .nodes
         .iter()

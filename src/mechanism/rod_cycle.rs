@@ -53,8 +53,8 @@ use serde::{Deserialize, Serialize};
 use super::closed_form::kinematics;
 use super::crank_slider::{CrankSlider, MechanismParams, RodInertia};
 use super::error::{DynamicsError, Result, positive};
-use super::motion::MotionSample;
 use super::gas::{CYCLE_DEG, GasForce};
+use super::motion::MotionSample;
 use super::peak::wrap_degrees_to;
 use super::scene::MAX_STEPS;
 
@@ -295,15 +295,19 @@ mod tests {
             assert_eq!(cyc.len(), 2 * n);
             assert_eq!(cyc[0].crank_angle_deg, 0.0);
             assert!((cyc[n].crank_angle_deg - 360.0).abs() < 1e-9);
-            assert!(cyc.iter().all(|i| (0.0..720.0).contains(&i.crank_angle_deg)));
+            assert!(
+                cyc.iter()
+                    .all(|i| (0.0..720.0).contains(&i.crank_angle_deg))
+            );
             let scene = DrivenScene {
                 omega_rad_s: OMEGA,
                 duration_s: 2.0 * std::f64::consts::TAU / OMEGA,
                 steps: 2 * n,
                 phi0_rad: 0.0,
             };
-            let d = driven_scene_with_gas(&p, &rod, Some(Arc::clone(&gas)), &scene, Method::ClosedForm)
-                .expect("scene");
+            let d =
+                driven_scene_with_gas(&p, &rod, Some(Arc::clone(&gas)), &scene, Method::ClosedForm)
+                    .expect("scene");
             let peak_a = d.fa_abs_n.iter().fold(0.0f64, |a, b| a.max(*b));
             let peak_b = d.fb_abs_n.iter().fold(0.0f64, |a, b| a.max(*b));
             let (mut ea, mut eb, mut eg) = (0.0f64, 0.0f64, 0.0f64);
@@ -318,7 +322,10 @@ mod tests {
                 eg = eg.max((inst.gas_force_n - gas_n[k]).abs() / gas.max_n());
             }
             eprintln!("engine cycle vs closed form: F_A {ea:.2e}, F_B {eb:.2e}, F_gas {eg:.2e}");
-            assert!(ea < 1e-9 && eb < 1e-9 && eg < 1e-12, "F_A {ea:e}, F_B {eb:e}");
+            assert!(
+                ea < 1e-9 && eb < 1e-9 && eg < 1e-12,
+                "F_A {ea:e}, F_B {eb:e}"
+            );
             // the gas force matters here: the firing peak is several times the inertia peak
             let no_gas = rod_frame_cycle(&p, &rod, OMEGA, n).expect("cycle");
             let peak = |c: &[RodFrameInstant]| {
@@ -326,7 +333,12 @@ mod tests {
                     .map(|i| i.f_a_on_rod_n[0].hypot(i.f_a_on_rod_n[1]))
                     .fold(0.0f64, f64::max)
             };
-            assert!(peak(&cyc) > 2.0 * peak(&no_gas), "{} vs {}", peak(&cyc), peak(&no_gas));
+            assert!(
+                peak(&cyc) > 2.0 * peak(&no_gas),
+                "{} vs {}",
+                peak(&cyc),
+                peak(&no_gas)
+            );
         }
         // without a gas force: exactly the one-revolution cycle
         let (p, rod) = &cases()[0];

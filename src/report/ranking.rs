@@ -318,9 +318,10 @@ pub const BUCKLING_AFTER: usize = 8;
 /// Whether any design has the engine's axial peaks (a study with a pressure trace): then the
 /// tables get the peak compression and tension columns after the peak pin force.
 pub fn has_engine_loads(results: &StudyResults) -> bool {
-    results.designs.iter().any(|d| {
-        d.dynamics.peak_compression_n.is_some()
-    })
+    results
+        .designs
+        .iter()
+        .any(|d| d.dynamics.peak_compression_n.is_some())
 }
 
 /// The headers of the engine columns, placed after [`ENGINE_AFTER`] columns of [`HEADERS`].

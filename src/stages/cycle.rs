@@ -11,11 +11,13 @@
 //! F_B of the dynamics at every instant; the stage reports how far those properties are from the
 //! STL's exact ones.
 
-use super::records::{DesignCycle, DesignMass, StageMesh};
+use super::records::{CosineBoreLoadCases, DesignCycle, DesignMass, StageMesh};
 use crate::config::StudyConfig;
 use crate::fem::QuadratureChoice;
+use crate::fem::body_force::mesh_mass_properties;
 use crate::fem::cycle::{
-    CycleOptions, CycleSolution, UnitSolutions, combine, rod_inertia_of, unit_solutions,
+    CycleOptions, CycleSolution, DEFAULT_DIRECTION_STEP_DEG, PinBasis, UnitSolutions, combine,
+    rod_inertia_of, unit_solutions_for,
 };
 use crate::fem::fatigue::MeanStress;
 use crate::fem::material::Material;
@@ -66,19 +68,22 @@ pub fn cycle(mass: &DesignMass, mesh: &StageMesh, config: &StudyConfig) -> Resul
         ultimate_pa: config.material.ultimate_mpa * 1e6,
         mean_stress: config.material.mean_stress,
         quadrature: QuadratureChoice::Auto,
+        direction_step_deg: DEFAULT_DIRECTION_STEP_DEG,
     };
-    let units =
-        unit_solutions(&mesh.mesh, &material, &mesh.bores, &options).with_context(context)?;
+    // the loads from the mesh's own mass properties (those the body forces integrate to)
+    let mesh_mass = mesh_mass_properties(&mesh.mesh, mass.density_kg_m3);
     let params = super::dynamics::engine_mechanism_for(mass, &config.engine, true);
     let gas = config.engine.gas_force().with_context(context)?;
     let instants = rod_frame_engine_cycle(
         &params,
-        &rod_inertia_of(&units.mass),
+        &rod_inertia_of(&mesh_mass),
         config.driven.omega_rad_s,
         config.cycle.instants,
         gas.as_deref(),
     )
     .with_context(context)?;
+    let units = unit_solutions_for(&mesh.mesh, &material, &mesh.bores, &options, &instants)
+        .with_context(context)?;
     let span_deg = if gas.is_some() { 720.0 } else { 360.0 };
     let cycle = combine(&units, &instants, &options).with_context(context)?;
     let analysis_seconds = start.elapsed().as_secs_f64();
@@ -112,6 +117,15 @@ pub fn cycle(mass: &DesignMass, mesh: &StageMesh, config: &StudyConfig) -> Resul
         peak_gas_force_n: gas
             .is_some()
             .then(|| instants.iter().map(|i| i.gas_force_n).fold(0.0, f64::max)),
+        cosine_bore_load: match &units.pin {
+            PinBasis::Linear => None,
+            PinBasis::Directions { step_deg, case_of } => Some(CosineBoreLoadCases {
+                direction_step_deg: *step_deg,
+                directions: case_of.len(),
+                directions_solved: case_of.iter().flatten().count(),
+                unit_solves: units.stresses.len(),
+            }),
+        },
         mean_stress: config.material.mean_stress,
         vtu: None,
         picture: None,

@@ -221,6 +221,7 @@ impl Setup {
             bores.loaded_arc_deg = m.pins.crank_bore_arc_deg;
             bores.fixed_arc_deg = m.pins.piston_bore_arc_deg;
         }
+        bores.bore_load = config.fem.bore_load;
         Setup {
             step,
             bores,

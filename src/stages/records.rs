@@ -206,6 +206,10 @@ pub struct DesignCycle {
     pub cycle_span_deg: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub peak_gas_force_n: Option<f64>,
+    /// With a cosine bore load (`[fem] bore_load = "cosine"`): the pin's unit directions (absent:
+    /// a uniform bore load, two pin cases).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cosine_bore_load: Option<CosineBoreLoadCases>,
     /// The mean-stress correction of the fatigue factor (absent: Goodman).
     #[serde(default, skip_serializing_if = "MeanStress::is_goodman")]
     pub mean_stress: MeanStress,
@@ -216,4 +220,16 @@ pub struct DesignCycle {
     pub analysis_seconds: f64,
     /// Wall time of the stage (its files, written by the report, not included), s.
     pub seconds: f64,
+}
+
+/// How the cycle superposes a cosine bore load ([`crate::fem::cycle`]): one unit case per pin
+/// direction, `direction_step_deg` apart, of which `directions_solved` (those next to a force
+/// direction of the cycle) were solved; `unit_solves` counts them with the four body forces, all
+/// from one factorisation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CosineBoreLoadCases {
+    pub direction_step_deg: f64,
+    pub directions: usize,
+    pub directions_solved: usize,
+    pub unit_solves: usize,
 }
