@@ -17,7 +17,9 @@ pub struct FemArgs {
     design: PathBuf,
     #[command(flatten)]
     mesh: MeshArgs,
-    /// Load magnitude [N] of both cases (default: the design's peak pin force).
+    /// Load magnitude [N] of both cases (default: the design's peak pin force); with a pressure
+    /// trace (`[engine]`) of the F_x case only, the F_y case carrying the largest pin force across
+    /// the rod over the cycle.
     #[arg(long)]
     force: Option<f64>,
     /// Settings file (as for `study`).

@@ -50,6 +50,11 @@ pub struct RodOptions {
     /// [`DEFAULT_SINGULAR_BAND_M`]).
     #[serde(default)]
     pub singular_band_m: Option<f64>,
+    /// The magnitude of the F_y case when it differs from the F_x case's (`None`: both are
+    /// `force_n`, the thesis' setting). The engine study sets it to the largest pin force across
+    /// the rod over the cycle.
+    #[serde(default)]
+    pub fy_force_n: Option<f64>,
 }
 
 /// Results of one load case. Stresses in MPa, lengths in mm, forces in N.
@@ -238,7 +243,8 @@ pub struct RodSolution {
     pub buckling: Option<super::buckling::BucklingMode>,
 }
 
-/// Analyses a rod: see the module documentation. `force_n` > 0 is the magnitude of both cases.
+/// Analyses a rod: see the module documentation. `force_n` > 0 is the magnitude of both cases
+/// (of F_x only when [`RodOptions::fy_force_n`] is set).
 pub fn solve_rod(
     mesh: &TetMesh,
     material: &Material,
@@ -259,24 +265,27 @@ pub fn solve_rod_fields(
 ) -> Result<RodSolution> {
     let t_all = Instant::now();
     material.validate()?;
-    if !(force_n.is_finite() && force_n > 0.0) {
-        return Err(FemError::InvalidInput(format!(
-            "force must be > 0 N, got {force_n}"
-        )));
+    let fy_force_n = options.fy_force_n.unwrap_or(force_n);
+    for f in [force_n, fy_force_n] {
+        if !(f.is_finite() && f > 0.0) {
+            return Err(FemError::InvalidInput(format!(
+                "force must be > 0 N, got {f}"
+            )));
+        }
     }
     let (loaded, fixed, axis, ex) = bores_and_direction(mesh, bores)?;
     // y = axis × x, in the plane of motion
     let ey = cross(axis, ex);
-    let cases = [("fx", ex), ("fy", ey)];
+    let cases = [("fx", ex, force_n), ("fy", ey, fy_force_n)];
     let loads = cases
         .iter()
-        .map(|(_, d)| {
+        .map(|(_, d, f)| {
             pin_load(
                 mesh,
                 &loaded.faces,
                 bores.loaded_centre_m,
                 axis,
-                d.map(|v| v * force_n),
+                d.map(|v| v * f),
                 bores.bore_load,
             )
         })
@@ -322,7 +331,7 @@ pub fn solve_rod_fields(
     let mut results = Vec::new();
     let mut fields = Vec::new();
     let mut estimates = Vec::new();
-    for (c, ((name, dir), load)) in cases.iter().zip(&loads).enumerate() {
+    for (c, ((name, dir, force_n), load)) in cases.iter().zip(&loads).enumerate() {
         let u = &sol.displacements[c];
         let field = stress_field(mesh, material, u)?;
         let recovered = recover_stress(mesh, material, u)?;
@@ -338,7 +347,7 @@ pub fn solve_rod_fields(
         for (d, r) in sol.reactions[c].iter().enumerate() {
             reaction[d % 3] += r;
         }
-        let bal = norm(std::array::from_fn(|j| reaction[j] + load.resultant_n[j])) / force_n;
+        let bal = norm(std::array::from_fn(|j| reaction[j] + load.resultant_n[j])) / *force_n;
         if bal > 1e-6 {
             return Err(FemError::Check(format!(
                 "case {name}: reactions {reaction:?} N do not balance the load {:?} N (relative {bal:.2e})",
@@ -349,7 +358,7 @@ pub fn solve_rod_fields(
         results.push(LoadCaseResult {
             name: name.to_string(),
             direction: *dir,
-            force_n,
+            force_n: *force_n,
             max_von_mises_unaveraged_mpa: un.value * 1e-6,
             max_von_mises_unaveraged_at_mm: mm(un.location_m),
             max_von_mises_unaveraged_element: un.element.unwrap_or(0),

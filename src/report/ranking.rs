@@ -501,6 +501,10 @@ pub fn explanation(results: &StudyResults) -> String {
         )
     } else {
         String::new()
+    } + if has_engine_loads(results) {
+        " Engine loads (a cylinder pressure trace): the F_x case carries the peak pin force (the firing compression), the F_y case the largest pin force across the rod over the cycle (inertia; the gas force acts along the rod); the peak compression and tension are along A→B at the crank pin, with their crank angles (0 = firing top dead centre)."
+    } else {
+        ""
     }
 }
 

@@ -21,7 +21,9 @@
 //! stay as they were). `rodstudy fem` always reports it.
 
 use super::criterion::{judge_buckling, verdict};
-use super::records::{AdaptiveSummary, DesignFem, LoadedDesign, MeshSummary, StageMesh};
+use super::records::{
+    AdaptiveSummary, DesignDynamics, DesignFem, LoadedDesign, MeshSummary, StageMesh,
+};
 use super::rod_surface::{RodFrameSurface, rod_frame_surface};
 use crate::config::{FemConfig, StudyConfig};
 use crate::fem::adapt::{AdaptOptions, adaptive_rod};
@@ -120,9 +122,13 @@ pub fn fem(
     Ok(outcome)
 }
 
-/// The load of the buckling case of a design: with a pressure trace its peak compression along
-/// A→B (`peak_compression_n` of stage 2), else its peak pin force (the F_x case's magnitude).
-pub fn buckling_load(design: &LoadedDesign, config: &StudyConfig) -> Result<f64> {
+/// The engine's loads of a design (with a pressure trace): stage 2's record on the configured
+/// engine (closed form), whose peak compression is the buckling case's load and whose largest
+/// pin force across the rod is the F_y case's magnitude. `None` without a trace.
+pub fn engine_loads(design: &LoadedDesign, config: &StudyConfig) -> Result<Option<DesignDynamics>> {
+    if config.engine.pressure_trace.is_none() {
+        return Ok(None);
+    }
     let mass = super::mass::mass(design)?;
     let (dynamics, _) = super::dynamics::dynamics_with(
         &mass,
@@ -131,6 +137,26 @@ pub fn buckling_load(design: &LoadedDesign, config: &StudyConfig) -> Result<f64>
         &config.engine,
         crate::mechanism::Method::ClosedForm,
     )?;
+    Ok(Some(dynamics))
+}
+
+/// The load of the buckling case of a design: with a pressure trace its peak compression along
+/// A→B (`peak_compression_n` of stage 2), else its peak pin force (the F_x case's magnitude).
+pub fn buckling_load(design: &LoadedDesign, config: &StudyConfig) -> Result<f64> {
+    let dynamics = match engine_loads(design, config)? {
+        Some(d) => d,
+        None => {
+            let mass = super::mass::mass(design)?;
+            super::dynamics::dynamics_with(
+                &mass,
+                &config.driven_scene(),
+                config.driven.gravity,
+                &config.engine,
+                crate::mechanism::Method::ClosedForm,
+            )?
+            .0
+        }
+    };
     Ok(dynamics
         .peak_compression_n
         .unwrap_or(dynamics.peak_pin_force_n))
@@ -191,8 +217,13 @@ const FRAME: &str = "rod frame, mm: origin at the crank pin A, x along A→B, z 
 
 impl Setup {
     /// `for_gmsh`: the surface is what gmsh will mesh (simplified); else a given mesh is solved
-    /// and the surface only tells the sharp re-entrant edges.
-    fn new(design: &LoadedDesign, config: &StudyConfig, for_gmsh: bool) -> Self {
+    /// and the surface only tells the sharp re-entrant edges. With a pressure trace the F_y case
+    /// carries the largest pin force across the rod over the engine's cycle ([`engine_loads`]).
+    fn new(design: &LoadedDesign, config: &StudyConfig, for_gmsh: bool) -> Result<Self> {
+        let context = format!("{}: FEM", design.file.display());
+        let fy_force_n = engine_loads(design, config)
+            .with_context(|| context.clone())?
+            .and_then(|d| d.peak_transverse_n);
         let surface = rod_frame_surface(design, for_gmsh);
         let singular_edges: Vec<[[f64; 3]; 2]> =
             reentrant_edges(&surface.vertices, &surface.triangles, FEATURE_ANGLE_DEG)
@@ -203,6 +234,7 @@ impl Setup {
             fixed_band_m: Some(config.fem.fixed_band_mm * 1e-3),
             singular_edges_m: singular_edges.clone(),
             singular_band_m: Some(config.fem.singular_band_mm * 1e-3),
+            fy_force_n,
             ..RodOptions::default()
         };
         let step = design.format.step().map(|_| {
@@ -222,15 +254,15 @@ impl Setup {
             bores.fixed_arc_deg = m.pins.piston_bore_arc_deg;
         }
         bores.bore_load = config.fem.bore_load;
-        Setup {
+        Ok(Setup {
             step,
             bores,
             surface,
             material: Material::from(&config.fem),
             singular_edges,
             rod,
-            context: format!("{}: FEM", design.file.display()),
-        }
+            context,
+        })
     }
 
     /// The gmsh adapter on this surface (writes `work_dir/rod_frame.stl`), or on the exact
@@ -303,7 +335,7 @@ pub fn fem_fixed(
     work_dir: &Path,
     size_mm: f64,
 ) -> Result<FemOutcome> {
-    let setup = Setup::new(design, config, true);
+    let setup = Setup::new(design, config, true)?;
     let mut mesher = setup.mesher(work_dir)?;
     let meshed = mesher
         .fixed(size_mm)
@@ -341,7 +373,7 @@ pub fn fem_adaptive(
     work_dir: &Path,
     settings: &AdaptiveMeshing,
 ) -> Result<FemOutcome> {
-    let setup = Setup::new(design, config, true);
+    let setup = Setup::new(design, config, true)?;
     let mut mesher = setup.mesher(work_dir)?;
     let facets = FacetScale::new(
         &setup.surface.vertices,
@@ -433,6 +465,7 @@ pub fn fem_user_mesh(
             .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
         (setup, read)
     });
+    let setup = setup?;
     let (read, read_time) =
         read.with_context(|| format!("{}: cannot use this volume mesh", file.display()))?;
     let start = std::time::Instant::now();
@@ -475,7 +508,7 @@ pub fn fem_refinement(
     sizes_mm: &[f64],
 ) -> Result<RefinementStudy> {
     // meshed in the rod frame, mm, as stage 3 meshes (any units and pose)
-    let setup = Setup::new(design, config, true);
+    let setup = Setup::new(design, config, true)?;
     let mesher = setup.mesher(work_dir)?;
     Ok(refinement_study(
         sizes_mm,

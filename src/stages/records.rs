@@ -58,6 +58,12 @@ pub struct DesignDynamics {
     /// The gas force p·A on the piston there [N].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub peak_tension_gas_force_n: Option<f64>,
+    /// With a pressure trace only: the largest pin force across the rod, max |F_A · ŷ| over the
+    /// cycle [N] (the F_y case's magnitude in the engine study), and its crank angle in [0, 720).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_transverse_n: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_transverse_crank_angle_deg: Option<f64>,
 }
 
 /// How the mesh was made.
