@@ -430,12 +430,12 @@ fn the_cache_key_follows_the_engine_and_the_trace() {
     );
 }
 
-/// The `cycle --json` record of design 5 on a fixed 8 mm mesh with `config` (a path relative to
+/// The `cycle --json` record of design 1 on a fixed 8 mm mesh with `config` (a path relative to
 /// the repository, or none).
 fn cycle_json(config: Option<&Path>, out: &Path) -> serde_json::Value {
     let mut args = vec![
         "cycle".to_string(),
-        "designs/design5.stl".into(),
+        "designs/design1.stl".into(),
         "--size".into(),
         "8".into(),
         "--json".into(),
@@ -478,7 +478,7 @@ fn the_engine_cycle_spans_720_degrees_with_the_gas_force() {
     assert!((last - 719.0).abs() < 1e-9, "{last}");
     let trace = example_config().engine.pressure_trace().unwrap().unwrap();
     let area = std::f64::consts::PI * 0.082f64.powi(2) / 4.0;
-    let peak_gas = trace.peak().1 * 1e5 * area;
+    let peak_gas = trace.peak().0 * 1e5 * area;
     let got = num(&engine, "peak_gas_force_n");
     assert!(
         (got - peak_gas).abs() < 1e-6 * peak_gas,
@@ -529,7 +529,7 @@ fn the_engine_fy_case_carries_the_largest_transverse_pin_force() {
     let out = rodstudy(&[
         "dynamics",
         "driven",
-        "designs/design5.stl",
+        "designs/design1.stl",
         "--config",
         "pipeline/examples/engine.toml",
         "--json",
@@ -547,7 +547,7 @@ fn the_engine_fy_case_carries_the_largest_transverse_pin_force() {
     let dir = tempdir("fy");
     let out = rodstudy(&[
         "fem",
-        "designs/design5.stl",
+        "designs/design1.stl",
         "--size",
         "8",
         "--config",
