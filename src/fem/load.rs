@@ -218,8 +218,9 @@ pub fn cosine_pressure_with_resultant(
     let (r1, r2) = (sum(&f1), sum(&f2));
     let (a11, a12, a21, a22) = (dot(r1, d), dot(r2, d), dot(r1, e), dot(r2, e));
     let det = a11 * a22 - a12 * a21;
-    if !(pressed_area > 0.0) || !(det.abs() > 1e-12 * a11.abs() * a22.abs().max(f64::MIN_POSITIVE))
-    {
+    let pressed = pressed_area > 0.0;
+    let solvable = det.abs() > 1e-12 * a11.abs() * a22.abs().max(f64::MIN_POSITIVE);
+    if !pressed || !solvable {
         return Err(FemError::InvalidInput(format!(
             "no bore wall on the half the pin presses on (force direction {d:?}): a partial bore \
              open on that side cannot carry a cosine bearing pressure; use bore_load = \"uniform\""

@@ -271,6 +271,7 @@ fn write_cycle_vtu(
     mesh: &TetMesh,
     cycle: &CycleSolution,
     units: &UnitSolutions,
+    gerber: bool,
 ) -> anyhow::Result<()> {
     let mpa = |v: &[f64]| v.iter().map(|x| x * 1e-6).collect::<Vec<_>>();
     // ∞ (an unloaded node) is written as a large finite number: ParaView reads no "inf"
@@ -294,7 +295,11 @@ fn write_cycle_vtu(
                 data: &mpa(&cycle.max_von_mises_pa),
             },
             VtuField {
-                name: "fatigue_safety_factor_goodman",
+                name: if gerber {
+                    "fatigue_safety_factor_gerber"
+                } else {
+                    "fatigue_safety_factor_goodman"
+                },
                 components: 1,
                 data: &factor,
             },
@@ -361,7 +366,7 @@ pub fn write_cycle_fields(
     use anyhow::Context;
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let vtu = dir.join("cycle.vtu");
-    write_cycle_vtu(&vtu, mesh, cycle, units)?;
+    write_cycle_vtu(&vtu, mesh, cycle, units, !record.mean_stress.is_goodman())?;
     let picture = dir.join("von_mises_cycle.svg");
     write_cycle_picture(&picture, mesh, cycle, record)?;
     record.vtu = Some(vtu);
