@@ -40,6 +40,10 @@ pub enum BenchCommand {
         /// With `--mesh`: also run CalculiX on the same mesh (pipeline/ccx_peer.py).
         #[arg(long, requires = "mesh")]
         ccx: bool,
+        /// The adaptive loop (the study's stage 3) per design, iteration and phase: mesh,
+        /// assembly, symbolic analysis, factorisation, solves, stresses with the estimate.
+        #[arg(long, conflicts_with = "mesh")]
+        adaptive: bool,
         /// Element size [mm].
         #[arg(long, default_value_t = 5.0)]
         size: f64,
@@ -105,6 +109,12 @@ pub fn run(command: BenchCommand) -> Result<i32> {
             json,
             ..
         } => bench_fem_mesh(designs, &mesh, force, repeats, ccx, json),
+        BenchCommand::Fem {
+            designs,
+            adaptive: true,
+            json,
+            ..
+        } => bench_fem_adaptive(designs, json),
         BenchCommand::Fem {
             designs,
             size,
@@ -191,6 +201,22 @@ fn bench_fem_mesh(
         println!("{}", serde_json::to_string_pretty(&b)?);
     } else {
         print!("{}", crate::bench::fem_mesh::markdown(&b));
+    }
+    Ok(0)
+}
+
+/// `bench fem --adaptive`: [`crate::bench::fem_adaptive`].
+fn bench_fem_adaptive(designs: Vec<PathBuf>, json: bool) -> Result<i32> {
+    let files = if designs.is_empty() {
+        crate::geometry::design::find_stl_files(&[PathBuf::from("designs")])?
+    } else {
+        crate::geometry::design::find_stl_files(&designs)?
+    };
+    let b = crate::bench::fem_adaptive::bench_fem_adaptive(&std::env::current_exe()?, &files)?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&b)?);
+    } else {
+        print!("{}", crate::bench::fem_adaptive::markdown(&b));
     }
     Ok(0)
 }

@@ -46,7 +46,9 @@ use super::error::{FemError, Result};
 use super::material::Material;
 use super::mesh::{TetMesh, dist};
 use super::recovery::node_elements;
-use super::rod::{AdaptiveStep, DEFAULT_FIXED_BAND_M, RodOptions, RodSolution, solve_rod_fields};
+use super::rod::{
+    AdaptiveStep, DEFAULT_FIXED_BAND_M, RodOptions, RodSolution, StepTimings, solve_rod_fields,
+};
 use super::shape::TET10_EDGES;
 
 /// Settings of the adaptive loop.
@@ -324,6 +326,11 @@ pub fn adaptive_rod(
                 order: q,
                 extrapolated_mpa: extrapolated * 1e-6,
                 seconds: 0.0,
+                timings: StepTimings {
+                    mesh_s: secs,
+                    analysis_s: sol.result.total_s,
+                    analysis: sol.result.timings,
+                },
             });
         }
         // the target is relative to the governing peak (the one the criterion judges): the

@@ -137,6 +137,20 @@ pub struct AdaptiveStep {
     pub extrapolated_mpa: f64,
     /// Wall time of this iteration (mesh, solve, estimate), s.
     pub seconds: f64,
+    /// Where this iteration's time went (wall times, not in `results.json`).
+    #[serde(default)]
+    pub timings: StepTimings,
+}
+
+/// The phases of one adaptive iteration, s: the mesh (gmsh), the analysis (`analysis_s`, of which
+/// the solver's phases and the stresses with their recovery and estimate) and the sizing of the
+/// next mesh (`seconds` less the mesh and the analysis).
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
+pub struct StepTimings {
+    pub mesh_s: f64,
+    pub analysis_s: f64,
+    #[serde(flatten)]
+    pub analysis: Timings,
 }
 
 /// A bore as found.
