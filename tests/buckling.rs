@@ -140,6 +140,7 @@ fn design1_against_calculix_buckle() {
         force,
         QuadratureChoice::Auto,
         &BucklingOptions::default(),
+        None,
     )
     .unwrap();
     let file = dir.path().join("design1_8mm.rodmesh");

@@ -107,7 +107,9 @@ pub fn run(args: FemArgs) -> Result<i32> {
         }
         return Ok(0);
     }
-    let mut outcome = stages::fem::fem(&design, force, &config, &args.out.join("mesh"), &mode)?;
+    // the factorised K of the final mesh is kept for the buckling case (the same supports)
+    let mut outcome =
+        stages::fem::fem_keeping(&design, force, &config, &args.out.join("mesh"), &mode, true)?;
     // buckling, always: under --force if given, else the peak compression (with a pressure
     // trace, where stage 3 has computed and judged it already) or the peak pin force (F_x)
     if outcome.record.buckling_load_factor.is_none() || args.force.is_some() {
@@ -115,7 +117,12 @@ pub fn run(args: FemArgs) -> Result<i32> {
             Some(f) => f,
             None => stages::fem::buckling_load(&design, &config)?,
         };
-        match stages::fem::buckling(&outcome.mesh, &config, load) {
+        match stages::fem::buckling(
+            &outcome.mesh,
+            &config,
+            load,
+            outcome.solution.system.as_deref(),
+        ) {
             Ok(b) => {
                 outcome.record.buckling_load_factor = Some(b.load_factor);
                 outcome.solution.buckling = Some(crate::fem::buckling::BucklingMode {
@@ -131,6 +138,7 @@ pub fn run(args: FemArgs) -> Result<i32> {
             }
         }
     }
+    outcome.solution.system = None;
     let buckling_load_n = outcome.solution.buckling.as_ref().map(|b| b.load_n);
     if args.no_pictures {
         crate::report::fields::write_fem_vtus(

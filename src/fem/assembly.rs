@@ -20,7 +20,7 @@ use super::mesh::TetMesh;
 const NONE: usize = usize::MAX;
 
 /// Map from DOFs (3 per node: x, y, z) to equations; prescribed DOFs carry a value.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct DofMap {
     eq: Vec<usize>,
     value: Vec<f64>,

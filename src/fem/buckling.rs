@@ -37,6 +37,7 @@ use super::geometric_stiffness::{GeometricKernel, geometric_kernel};
 use super::material::Material;
 use super::mesh::TetMesh;
 use super::solver::{CholeskyFactor, SymbolicFactor};
+use super::statics::FactorisedSystem;
 
 /// Options of [`solve_buckling`].
 #[derive(Clone, Copy, Debug, Serialize, Deserialize)]
@@ -191,13 +192,9 @@ fn start_block(b: &[f64], n: usize, p: usize) -> Vec<f64> {
     x
 }
 
-/// Solves the buckling problem: see the module documentation.
-pub fn solve_buckling(
-    problem: &BucklingProblem,
-    options: &BucklingOptions,
-) -> Result<BucklingSolution> {
-    let mesh = problem.mesh;
-    let n_dofs = mesh.n_dofs();
+/// The checks of a problem and its options before any work.
+fn check_problem(problem: &BucklingProblem, options: &BucklingOptions) -> Result<()> {
+    let n_dofs = problem.mesh.n_dofs();
     if problem.load.len() != n_dofs {
         return Err(FemError::InvalidInput(format!(
             "the load has {} entries, the mesh {n_dofs} DOFs",
@@ -209,16 +206,65 @@ pub fn solve_buckling(
             "the buckling iteration needs a block of at least one vector".into(),
         ));
     }
+    Ok(())
+}
+
+/// Solves the buckling problem: see the module documentation.
+pub fn solve_buckling(
+    problem: &BucklingProblem,
+    options: &BucklingOptions,
+) -> Result<BucklingSolution> {
+    check_problem(problem, options)?;
+    let mesh = problem.mesh;
+    let n_dofs = mesh.n_dofs();
     let t0 = Instant::now();
     let prescribed: Vec<(usize, f64)> = problem.fixed_dofs.iter().map(|&d| (d, 0.0)).collect();
     let dofs = DofMap::new(n_dofs, &prescribed)?;
-    let n = dofs.n_eq();
-    if n == 0 {
+    if dofs.n_eq() == 0 {
         return Err(FemError::InvalidInput("every DOF is prescribed".into()));
     }
     let asm = assemble(mesh, &problem.material, problem.quadrature, &dofs)?;
     let symbolic = SymbolicFactor::analyse(&asm.k)?;
     let factor = CholeskyFactor::factorise(&symbolic, &asm.k)?;
+    let system = FactorisedSystem {
+        dofs,
+        k: asm.k,
+        factor,
+    };
+    buckling_on(problem, &system, options, t0)
+}
+
+/// [`solve_buckling`] on the factorised K of a static solve with the same mesh, material,
+/// quadrature and supports ([`super::statics::solve_static_keeping`]): no assembly and no
+/// factorisation of K again, and the same K to the bit. A system whose supports differ from the
+/// problem's is refused.
+pub fn solve_buckling_with(
+    problem: &BucklingProblem,
+    system: &FactorisedSystem,
+    options: &BucklingOptions,
+) -> Result<BucklingSolution> {
+    let t0 = Instant::now();
+    check_problem(problem, options)?;
+    let prescribed: Vec<(usize, f64)> = problem.fixed_dofs.iter().map(|&d| (d, 0.0)).collect();
+    if DofMap::new(problem.mesh.n_dofs(), &prescribed)? != system.dofs {
+        return Err(FemError::InvalidInput(
+            "the factorised system has other supports than the buckling problem".into(),
+        ));
+    }
+    buckling_on(problem, system, options, t0)
+}
+
+/// The pre-stress, K_σ and the iteration on a factorised K (`t0`: when the analysis started).
+fn buckling_on(
+    problem: &BucklingProblem,
+    system: &FactorisedSystem,
+    options: &BucklingOptions,
+    t0: Instant,
+) -> Result<BucklingSolution> {
+    let mesh = problem.mesh;
+    let n_dofs = mesh.n_dofs();
+    let (dofs, factor) = (&system.dofs, &system.factor);
+    let n = dofs.n_eq();
     // the pre-stress: the static solution of the reference load, with the same factor
     let mut b = vec![0.0; n];
     for (d, f) in problem.load.iter().enumerate() {
@@ -246,8 +292,8 @@ pub fn solve_buckling(
         mesh,
         &problem.material,
         options.geometric_quadrature,
-        &dofs,
-        &asm.k,
+        dofs,
+        &system.k,
         &u,
     )?;
     // G = −K_σ: K φ = λ G φ
@@ -345,7 +391,7 @@ pub fn solve_buckling(
     }
     // the mode, its residual, its scale
     let phi = &x[..n];
-    let kphi = asm.k.mul(phi);
+    let kphi = system.k.mul(phi);
     let gphi = g.mul(phi);
     let num: f64 = kphi
         .iter()

@@ -21,11 +21,14 @@ use super::load::{BoreLoad, pin_load};
 use super::material::Material;
 use super::mesh::TetMesh;
 use super::recovery::recover_stress;
-use super::statics::{StaticProblem, Timings, solve_static};
+use super::statics::{
+    FactorisedSystem, StaticProblem, Timings, solve_static, solve_static_keeping,
+};
 use super::stress::{
     StressField, displacement_magnitudes, nodes_away_from, nodes_away_from_segments, peak_nodal,
     peak_unaveraged, stress_field,
 };
+use std::sync::Arc;
 
 /// The default band around the fixed bore excluded from the judged stress measure: 6 mm.
 pub const DEFAULT_FIXED_BAND_M: f64 = 6e-3;
@@ -55,6 +58,10 @@ pub struct RodOptions {
     /// the rod over the cycle.
     #[serde(default)]
     pub fy_force_n: Option<f64>,
+    /// Keep the factorised K in [`RodSolution::system`] for the buckling case on the same mesh
+    /// (its supports are stage 3's), which then neither assembles nor factorises K again.
+    #[serde(skip)]
+    pub keep_system: bool,
 }
 
 /// Results of one load case. Stresses in MPa, lengths in mm, forces in N.
@@ -255,6 +262,8 @@ pub struct RodSolution {
     /// The buckling mode of the F_x case, when buckling was computed
     /// ([`super::rod_buckling::rod_buckling`]; set by the caller, `None` from [`solve_rod_fields`]).
     pub buckling: Option<super::buckling::BucklingMode>,
+    /// The factorised K of the static cases, when [`RodOptions::keep_system`] asked for it.
+    pub system: Option<Arc<FactorisedSystem>>,
 }
 
 /// Analyses a rod: see the module documentation. `force_n` > 0 is the magnitude of both cases
@@ -317,7 +326,12 @@ pub fn solve_rod_fields(
         loads: loads.iter().map(|l| l.forces.clone()).collect(),
         quadrature: options.quadrature,
     };
-    let sol = solve_static(&problem)?;
+    let (sol, system) = if options.keep_system {
+        let (sol, system) = solve_static_keeping(&problem)?;
+        (sol, Some(Arc::new(system)))
+    } else {
+        (solve_static(&problem)?, None)
+    };
 
     let t_stress = Instant::now();
     let band = options.fixed_band_m.unwrap_or(DEFAULT_FIXED_BAND_M);
@@ -443,6 +457,7 @@ pub fn solve_rod_fields(
         singularity_floor_m: chase_floor,
         estimates: [e0, e1],
         buckling: None,
+        system,
     };
     Ok(solution)
 }

@@ -7,7 +7,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::assembly::{DofMap, assemble};
+use super::assembly::{DofMap, SparseSym, assemble};
 use super::element::{QuadratureChoice, element_stiffness};
 use super::error::{FemError, Result};
 use super::material::Material;
@@ -78,8 +78,26 @@ pub struct StaticSolution {
     pub timings: Timings,
 }
 
+/// The factorised stiffness of a static solve, kept for another analysis on the same mesh,
+/// material, quadrature and supports (the buckling case of the rod: [`super::buckling`]), which
+/// then needs neither the assembly nor the factorisation again.
+#[derive(Debug)]
+pub struct FactorisedSystem {
+    /// The equations (the supports' DOFs prescribed).
+    pub dofs: DofMap,
+    /// K of the free DOFs (upper triangle).
+    pub k: SparseSym,
+    /// Its Cholesky factor.
+    pub factor: CholeskyFactor,
+}
+
 /// Solves `problem`.
 pub fn solve_static(problem: &StaticProblem) -> Result<StaticSolution> {
+    solve_static_keeping(problem).map(|(solution, _)| solution)
+}
+
+/// [`solve_static`], returning the factorised system too.
+pub fn solve_static_keeping(problem: &StaticProblem) -> Result<(StaticSolution, FactorisedSystem)> {
     let mesh = problem.mesh;
     let n_dofs = mesh.n_dofs();
     if problem.loads.is_empty() {
@@ -153,13 +171,20 @@ pub fn solve_static(problem: &StaticProblem) -> Result<StaticSolution> {
         curved_elements: asm.curved_elements,
         min_det_j: asm.min_det_j,
     };
-    Ok(StaticSolution {
-        displacements,
-        reactions,
-        residual_rel,
-        stats,
-        timings,
-    })
+    Ok((
+        StaticSolution {
+            displacements,
+            reactions,
+            residual_rel,
+            stats,
+            timings,
+        },
+        FactorisedSystem {
+            dofs,
+            k: asm.k,
+            factor,
+        },
+    ))
 }
 
 /// K u − f at the prescribed DOFs, from the elements that have a prescribed DOF.

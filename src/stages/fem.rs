@@ -32,6 +32,7 @@ use crate::fem::facets::{FacetScale, reentrant_edges};
 use crate::fem::refinement::{RefinementStudy, refinement_study};
 use crate::fem::rod::{RodSolution, solve_rod_fields};
 use crate::fem::rod_buckling::rod_buckling;
+use crate::fem::statics::FactorisedSystem;
 use crate::fem::{BoreSpec, Material, RodOptions, TetMesh};
 use crate::mesher::{GmshRodMesher, MESHER_SCRIPT, MeshReport, StepInRodFrame, read_volume_mesh};
 use crate::python_env::{pipeline_script, python};
@@ -108,16 +109,35 @@ pub fn fem(
     work_dir: &Path,
     mode: &MeshMode,
 ) -> Result<FemOutcome> {
+    fem_keeping(design, force_n, config, work_dir, mode, false)
+}
+
+/// [`fem`]; `keep_system`: the outcome keeps the factorised K of the final mesh
+/// ([`RodSolution::system`]) for a buckling analysis the caller runs on it (`fem` itself keeps it
+/// while it judges buckling in the engine study, then drops it).
+pub fn fem_keeping(
+    design: &LoadedDesign,
+    force_n: f64,
+    config: &StudyConfig,
+    work_dir: &Path,
+    mode: &MeshMode,
+    keep_system: bool,
+) -> Result<FemOutcome> {
+    let engine = config.engine.pressure_trace.is_some();
+    let keep = keep_system || engine;
     let mut outcome = match mode {
-        MeshMode::Fixed(size_mm) => fem_fixed(design, force_n, config, work_dir, *size_mm),
-        MeshMode::Adaptive(a) => fem_adaptive(design, force_n, config, work_dir, a),
-        MeshMode::User(file) => fem_user_mesh(design, force_n, config, work_dir, file),
+        MeshMode::Fixed(size_mm) => fem_fixed(design, force_n, config, work_dir, *size_mm, keep),
+        MeshMode::Adaptive(a) => fem_adaptive(design, force_n, config, work_dir, a, keep),
+        MeshMode::User(file) => fem_user_mesh(design, force_n, config, work_dir, file, keep),
     }?;
     // the engine study (a pressure trace) also judges buckling under the peak compression
-    if config.engine.pressure_trace.is_some() {
+    if engine {
         let load = buckling_load(design, config)?;
         add_buckling(&mut outcome, config, load)
             .with_context(|| format!("{}: buckling", design.file.display()))?;
+    }
+    if !keep_system {
+        outcome.solution.system = None;
     }
     Ok(outcome)
 }
@@ -165,10 +185,12 @@ pub fn buckling_load(design: &LoadedDesign, config: &StudyConfig) -> Result<f64>
 /// Linear buckling of the rod on stage 3's mesh (supports as stage 3: bore B fixed) under the
 /// compression `compression_n` on bore A towards B (the F_x case;
 /// [`crate::fem::rod_buckling::rod_buckling`]): the smallest positive load factor λ₁ and its mode.
+/// `system`: the factorised K of stage 3 on this mesh, if kept ([`fem_keeping`]).
 pub fn buckling(
     stage: &StageMesh,
     config: &StudyConfig,
     compression_n: f64,
+    system: Option<&FactorisedSystem>,
 ) -> Result<BucklingSolution> {
     Ok(rod_buckling(
         &stage.mesh,
@@ -177,6 +199,7 @@ pub fn buckling(
         compression_n,
         RodOptions::default().quadrature,
         &BucklingOptions::default(),
+        system,
     )?)
 }
 
@@ -188,7 +211,12 @@ pub fn add_buckling(
     config: &StudyConfig,
     compression_n: f64,
 ) -> Result<()> {
-    let b = buckling(&outcome.mesh, config, compression_n)?;
+    let b = buckling(
+        &outcome.mesh,
+        config,
+        compression_n,
+        outcome.solution.system.as_deref(),
+    )?;
     outcome.record.buckling_load_factor = Some(b.load_factor);
     judge_buckling(&mut outcome.record.criterion, b.load_factor, config);
     outcome.solution.buckling = Some(BucklingMode {
@@ -219,7 +247,12 @@ impl Setup {
     /// `for_gmsh`: the surface is what gmsh will mesh (simplified); else a given mesh is solved
     /// and the surface only tells the sharp re-entrant edges. With a pressure trace the F_y case
     /// carries the largest pin force across the rod over the engine's cycle ([`engine_loads`]).
-    fn new(design: &LoadedDesign, config: &StudyConfig, for_gmsh: bool) -> Result<Self> {
+    fn new(
+        design: &LoadedDesign,
+        config: &StudyConfig,
+        for_gmsh: bool,
+        keep_system: bool,
+    ) -> Result<Self> {
         let context = format!("{}: FEM", design.file.display());
         let fy_force_n = engine_loads(design, config)
             .with_context(|| context.clone())?
@@ -235,6 +268,7 @@ impl Setup {
             singular_edges_m: singular_edges.clone(),
             singular_band_m: Some(config.fem.singular_band_mm * 1e-3),
             fy_force_n,
+            keep_system,
             ..RodOptions::default()
         };
         let step = design.format.step().map(|_| {
@@ -334,8 +368,9 @@ pub fn fem_fixed(
     config: &StudyConfig,
     work_dir: &Path,
     size_mm: f64,
+    keep_system: bool,
 ) -> Result<FemOutcome> {
-    let setup = Setup::new(design, config, true)?;
+    let setup = Setup::new(design, config, true, keep_system)?;
     let mut mesher = setup.mesher(work_dir)?;
     let meshed = mesher
         .fixed(size_mm)
@@ -372,8 +407,9 @@ pub fn fem_adaptive(
     config: &StudyConfig,
     work_dir: &Path,
     settings: &AdaptiveMeshing,
+    keep_system: bool,
 ) -> Result<FemOutcome> {
-    let setup = Setup::new(design, config, true)?;
+    let setup = Setup::new(design, config, true, keep_system)?;
     let mut mesher = setup.mesher(work_dir)?;
     let facets = FacetScale::new(
         &setup.surface.vertices,
@@ -451,6 +487,7 @@ pub fn fem_user_mesh(
     config: &StudyConfig,
     work_dir: &Path,
     file: &Path,
+    keep_system: bool,
 ) -> Result<FemOutcome> {
     // the mesh is read (gmsh MSH 4.1 and .inp natively, other formats through meshio, into
     // work_dir/user.rodmesh) while the rod-frame surface and its singular edges are prepared
@@ -459,7 +496,7 @@ pub fn fem_user_mesh(
             let start = std::time::Instant::now();
             read_volume_mesh(file, "mm", work_dir).map(|(m, _)| (m, start.elapsed()))
         });
-        let setup = Setup::new(design, config, false);
+        let setup = Setup::new(design, config, false, keep_system);
         let read = reading
             .join()
             .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
@@ -508,7 +545,7 @@ pub fn fem_refinement(
     sizes_mm: &[f64],
 ) -> Result<RefinementStudy> {
     // meshed in the rod frame, mm, as stage 3 meshes (any units and pose)
-    let setup = Setup::new(design, config, true)?;
+    let setup = Setup::new(design, config, true, false)?;
     let mesher = setup.mesher(work_dir)?;
     Ok(refinement_study(
         sizes_mm,
