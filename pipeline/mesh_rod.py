@@ -13,11 +13,20 @@ Two commands, both ending with one line of JSON on standard output (progress goe
       may stop with "overlapping facets" or even crash), so the mesh is made in a child process and a
       fixed ladder of classification settings is tried in order (`LADDER`: dihedral angle, curve
       split angle) until one succeeds; the JSON says which rung was used and why earlier ones failed.
+      Where every rung fails, the surface is meshed differently (`FALLBACKS`, in this order): "local
+      refinement" (the sizes reduced around the patches gmsh blames, round after round) and "STL
+      surface kept" (the STL's own triangles as the boundary, only the interior meshed), both on the
+      bonded body where the STL holds shells touching face to face (`bond_shells`); the JSON's
+      `fallback` names the one that made the mesh (null for the usual mesh). A total failure ends
+      in one line that lists everything tried and what to try. Children stop a little before the
+      Rust side's time limit (RODSTUDY_MESHER_TIMEOUT_S, default 600 s), so that line is written.
       Writes OUT_DIR/NAME.msh (gmsh MSH 4.1, for the user) and OUT_DIR/NAME.rodmesh (the hand-off
       file the Rust side reads, see below). The .rodmesh is made from the .msh through meshio, i.e.
       by the very same code path as `convert`.
       JSON: paths, node and element counts, min/mean scaled Jacobian and SICN (gmsh
-      `getElementQualities` "minSJ" / "minSICN"), whether elements are curved, timings.
+      `getElementQualities` "minSJ" / "minSICN"), whether elements are curved, timings, the
+      fallback used (`fallback`, `fallback_detail`: rounds and refined patches, or the boundary
+      triangles kept).
 
       --size-field FILE: a local element size map for adaptive refinement, as gmsh's
       `examples/api/adapt_mesh.py` does it: a list-based post-processing view of scalar tetrahedra
@@ -28,7 +37,8 @@ Two commands, both ending with one line of JSON on standard output (progress goe
       --geometry FILE: the classified surface (gmsh's `classifySurfaces` result, MSH) is written to
       FILE (with FILE.json naming the classification setting) on first use and read back on later
       calls, so an adaptive sequence classifies the STL once (classification is most of the time of
-      a coarse mesh); a later call tries that classification only.
+      a coarse mesh); a later call tries that classification only, then the fallbacks ("local
+      refinement" on that classification, the size field's sizes reduced around the patches blamed).
 
       The 3D mesher is HXT (one thread: deterministic); where it refuses a surface mesh, gmsh's
       Delaunay with Netgen optimisation is tried on the same classification.
@@ -80,7 +90,9 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import pathlib
+import re
 import subprocess
 import sys
 import time
@@ -92,6 +104,31 @@ FORMAT_HEADER = "rodmesh 1"
 # Classification settings tried in order, (dihedral angle, curve split angle) in degrees. The first
 # works for most rods; splitting curves at 60 degree kinks helps where tiny faces meet large ones.
 LADDER = [(40.0, 180.0), (40.0, 60.0), (30.0, 180.0), (50.0, 180.0), (30.0, 60.0), (50.0, 60.0)]
+
+# Strategies that change the surface mesh rather than only its classification, tried in this order
+# when every rung of LADDER fails (`fallback` in the JSON names the one that succeeded):
+#   "local refinement": the classification of the first rung (or the cached one), meshed again
+#       with the mesh size reduced around the patch gmsh names in "overlapping facets on surface A
+#       surface B" (the smaller of the two, by area; a sliver face where a thin feature meets a large
+#       curved one): each round halves the size within reach of that patch's boundary curves and
+#       grows back to the target over twice the target size; up to LOCAL_ROUNDS rounds, never below
+#       LOCAL_MIN_SIZE_MM. gmsh's Delaunay (which names the surfaces; HXT does not); TetGen's "PLC
+#       Error", which names nothing, refines the patch refined last once more.
+#   "STL surface kept": no reparametrisation at all: the STL's own triangles (the surface handed
+#       over, already simplified by the Rust side's quadric error metrics) are the boundary of the
+#       volume mesh; only the interior is meshed at the target size. Exact to the STL, more
+#       elements (the facets set the sizes at the surface). Delaunay + Netgen (HXT's optimiser
+#       takes minutes on a fine boundary).
+# An STL whose shells touch face to face (a rod and its cap as two bodies) is first bonded
+# (`bond_shells`: the coincident faces removed) and both fallbacks mesh the bonded body
+# (`fallback`: "shells bonded, ...").
+FALLBACKS = ("local refinement", "STL surface kept")
+LOCAL_ROUNDS = 12
+LOCAL_MIN_SIZE_MM = 0.1
+
+# What to try when nothing works (the last line of a total failure).
+WHAT_TO_TRY = ("try: an STL exported at a different chord tolerance (finer or coarser), a STEP export of "
+               "the part (meshed on the exact geometry), another --size, or a volume mesh of your own (--mesh)")
 
 # Smallest acceptable signed inverse condition number of an element (a sliver makes K
 # ill-conditioned: the reactions stop balancing the load to 1e-6).
@@ -145,23 +182,46 @@ def gmsh_options(size_mm: float, curved: bool, size_field: bool = False) -> dict
     return opts
 
 
-def add_size_field(path: pathlib.Path) -> int:
-    """The size map of `path` (raw float64, 16 per tetrahedron: x0..x3, y0..y3, z0..z3, s0..s3) as a
-    list-based view and a PostView background field."""
-    import gmsh
-
+def read_size_field(path: pathlib.Path) -> np.ndarray:
+    """The size map of `path`, checked: one row of 16 float64 per tetrahedron."""
     data = np.fromfile(str(path), dtype="<f8")
     if data.size == 0 or data.size % 16:
         raise SystemExit(f"mesh_rod: {path}: a size field holds 16 float64 per tetrahedron, got {data.size} values")
     sizes = data.reshape(-1, 16)[:, 12:]
     if not (np.isfinite(data).all() and (sizes > 0).all()):
         raise SystemExit(f"mesh_rod: {path}: sizes must be finite and > 0")
+    return data.reshape(-1, 16)
+
+
+def add_size_field(path: pathlib.Path, background: bool = True) -> tuple[int, int]:
+    """The size map of `path` (raw float64, 16 per tetrahedron: x0..x3, y0..y3, z0..z3, s0..s3) as a
+    list-based view and a PostView field (the background field unless `background` is false);
+    returns (tetrahedra, field tag)."""
+    import gmsh
+
+    data = read_size_field(path).reshape(-1)
     view = gmsh.view.add("size field")
     gmsh.view.addListData(view, "SS", data.size // 16, data.tolist())
     field = gmsh.model.mesh.field.add("PostView")
     gmsh.model.mesh.field.setNumber(field, "ViewTag", view)
-    gmsh.model.mesh.field.setAsBackgroundMesh(field)
-    return data.size // 16
+    if background:
+        gmsh.model.mesh.field.setAsBackgroundMesh(field)
+    return data.size // 16, field
+
+
+def tet10_qualities() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The tags of the model's 10-node tetrahedra (the only elements of dimension 3 allowed) and
+    their minSJ and minSICN."""
+    import gmsh
+
+    types, tags, _ = gmsh.model.mesh.getElements(3)
+    tet10 = [t for ty, t in zip(types, tags) if ty == 11]
+    if not tet10 or len(types) != 1:
+        raise RuntimeError(f"gmsh produced element types {list(types)}, expected only 10-node tets (11)")
+    tags10 = np.asarray(tet10[0])
+    min_sj = np.asarray(gmsh.model.mesh.getElementQualities(tags10, "minSJ"))
+    min_sicn = np.asarray(gmsh.model.mesh.getElementQualities(tags10, "minSICN"))
+    return tags10, min_sj, min_sicn
 
 
 def gmsh_volume_mesh(stl: pathlib.Path, size_mm: float, curved: bool, angle_deg: float,
@@ -196,17 +256,11 @@ def gmsh_volume_mesh(stl: pathlib.Path, size_mm: float, curved: bool, angle_deg:
         loop = gmsh.model.geo.addSurfaceLoop(surfaces)
         gmsh.model.geo.addVolume([loop])
         gmsh.model.geo.synchronize()
-        size_field_tets = add_size_field(size_field) if size_field is not None else 0
+        size_field_tets = add_size_field(size_field)[0] if size_field is not None else 0
         t1 = time.perf_counter()
         gmsh.model.mesh.generate(3)
         t2 = time.perf_counter()
-        types, tags, _ = gmsh.model.mesh.getElements(3)
-        tet10 = [t for ty, t in zip(types, tags) if ty == 11]
-        if not tet10 or len(types) != 1:
-            raise RuntimeError(f"gmsh produced element types {list(types)}, expected only 10-node tets (11)")
-        tags10 = np.asarray(tet10[0])
-        min_sj = np.asarray(gmsh.model.mesh.getElementQualities(tags10, "minSJ"))
-        min_sicn = np.asarray(gmsh.model.mesh.getElementQualities(tags10, "minSICN"))
+        tags10, min_sj, min_sicn = tet10_qualities()
         if delaunay is False and min_sicn.min() < MIN_SICN:
             # HXT can leave a sliver its optimiser does not remove; the caller retries with
             # Delaunay + Netgen, whose optimiser does
@@ -265,7 +319,41 @@ def run_attempt_with(stl: pathlib.Path, size: float, curved: bool, angle: float,
                         ("--geometry-out", geometry_out)):
         if value is not None:
             cmd += [flag, str(value)]
-    run = subprocess.run(cmd, capture_output=True, text=True)
+    return run_child(cmd)
+
+
+# The time limit of the whole `mesh` command: the Rust side kills the mesher after
+# RODSTUDY_MESHER_TIMEOUT_S (default 600 s); the children here stop a little before, so that a
+# fallback that runs out of time still ends in a message that says what was tried.
+DEADLINE = [math.inf]
+
+
+def set_deadline(t0: float) -> None:
+    try:
+        limit = float(os.environ.get("RODSTUDY_MESHER_TIMEOUT_S", "600"))
+    except ValueError:
+        limit = 600.0
+    if not (math.isfinite(limit) and limit > 0):
+        limit = 600.0
+    DEADLINE[0] = t0 + limit - max(3.0, 0.05 * limit)
+
+
+def out_of_time() -> bool:
+    return time.perf_counter() >= DEADLINE[0]
+
+
+def run_child(cmd: list) -> tuple[dict | None, str]:
+    """Runs one gmsh child (this script) until DEADLINE: its JSON, or None and why it failed."""
+    left = DEADLINE[0] - time.perf_counter()
+    if left <= 0:
+        return None, "not tried: the mesher's time limit was reached"
+    try:
+        run = subprocess.run(cmd, capture_output=True, text=True, timeout=None if math.isinf(left) else left)
+    except subprocess.TimeoutExpired:
+        return None, "stopped at the mesher's time limit (RODSTUDY_MESHER_TIMEOUT_S)"
+    for line in run.stderr.splitlines():
+        if line.startswith("mesh_rod:   "):  # a child's progress (the fallbacks' rounds)
+            log(line[len("mesh_rod: "):])
     if run.returncode == 0:
         return json.loads(run.stdout.strip().splitlines()[-1]), ""
     lines = [l for l in run.stderr.strip().splitlines() if l.strip()]
@@ -273,6 +361,298 @@ def run_attempt_with(stl: pathlib.Path, size: float, curved: bool, angle: float,
     if run.returncode < 0:
         why = f"gmsh crashed (signal {-run.returncode})"
     return None, why
+
+
+# ---------------------------------------------------------------------------------------------
+# fallbacks: a new surface mesh where every classification of LADDER fails (see FALLBACKS)
+# ---------------------------------------------------------------------------------------------
+
+def patch_facts(classified: pathlib.Path) -> tuple[dict, dict]:
+    """Area (mm²) and centroid (mean of the nodes) of every patch of a classified surface, from its
+    STL triangles."""
+    import gmsh
+
+    gmsh.initialize(["mesh_rod"], readConfigFiles=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.merge(str(classified))
+        node_tags, coords, _ = gmsh.model.mesh.getNodes()
+        xyz = np.zeros((int(node_tags.max()) + 1, 3))
+        xyz[node_tags.astype(np.int64)] = np.asarray(coords).reshape(-1, 3)
+        areas, centroids = {}, {}
+        for _, tag in gmsh.model.getEntities(2):
+            types, _, nodes = gmsh.model.mesh.getElements(2, tag)
+            t = np.concatenate([np.asarray(n, dtype=np.int64) for ty, n in zip(types, nodes) if ty == 2])
+            t = t.reshape(-1, 3)
+            a, b, c = xyz[t[:, 0]], xyz[t[:, 1]], xyz[t[:, 2]]
+            areas[tag] = 0.5 * float(np.linalg.norm(np.cross(b - a, c - a), axis=1).sum())
+            centroids[tag] = xyz[np.unique(t)].mean(axis=0)
+        return areas, centroids
+    finally:
+        gmsh.finalize()
+
+
+def field_size_near(data: np.ndarray, p: np.ndarray) -> float:
+    """The smallest size of the size-field tetrahedron whose centroid is nearest to `p`."""
+    centroids = np.stack([data[:, 0:4].mean(axis=1), data[:, 4:8].mean(axis=1), data[:, 8:12].mean(axis=1)],
+                         axis=1)
+    k = int(np.argmin(((centroids - p) ** 2).sum(axis=1)))
+    return float(data[k, 12:16].min())
+
+
+def add_refinement(refine: dict, size: float, base_field: int | None) -> None:
+    """Background field: the smaller of `base_field` (the size field, if any) and, per refined
+    patch, its size h within h of the patch's boundary curves, growing linearly to `size` at h +
+    2·size."""
+    import gmsh
+
+    F = gmsh.model.mesh.field
+    fields = [] if base_field is None else [base_field]
+    for tag, h in sorted(refine.items()):
+        curves = sorted({abs(c) for _, c in gmsh.model.getBoundary([(2, tag)], oriented=False)})
+        if not curves:
+            continue
+        # sample the curves at h/4 (their bounding box diagonal as the length), 20..2000 points each
+        longest = max(math.dist(bb[:3], bb[3:]) for bb in (gmsh.model.getBoundingBox(1, c) for c in curves))
+        distance = F.add("Distance")
+        F.setNumbers(distance, "CurvesList", curves)
+        F.setNumber(distance, "Sampling", int(min(2000, max(20, math.ceil(4.0 * longest / h)))))
+        threshold = F.add("Threshold")
+        F.setNumber(threshold, "InField", distance)
+        F.setNumber(threshold, "SizeMin", h)
+        F.setNumber(threshold, "SizeMax", size)
+        F.setNumber(threshold, "DistMin", h)
+        F.setNumber(threshold, "DistMax", h + 2.0 * size)
+        fields.append(threshold)
+    if not fields:
+        return
+    if len(fields) == 1:
+        F.setAsBackgroundMesh(fields[0])
+        return
+    smallest = F.add("Min")
+    F.setNumbers(smallest, "FieldsList", fields)
+    F.setAsBackgroundMesh(smallest)
+
+
+def surfaces_named(error: str, messages: list[str]) -> list[int]:
+    """The entities gmsh blames for a failed boundary recovery: the surfaces of "Invalid boundary
+    mesh (overlapping facets) on surface A surface B", else those of the last "1st: [...] #A" and
+    "2nd: [...] #B" lines of its log (a facet or segment and the entity it lies on)."""
+    if "overlapping facets" in error:
+        return [int(t) for t in re.findall(r"surface (\d+)", error)]
+    tags = []
+    for m in reversed(messages[-40:]):
+        hit = re.search(r"(1st|2nd): \[[^\]]*\] #(\d+)", m)
+        if hit:
+            tags.append(int(hit.group(2)))
+            if len(tags) == 2:
+                break
+    return tags
+
+
+def gmsh_local_refinement(stl: pathlib.Path, size_mm: float, angle_deg: float, curve_angle_deg: float,
+                          msh_out: pathlib.Path, size_field: pathlib.Path | None,
+                          geometry_in: pathlib.Path | None, geometry_out: pathlib.Path | None) -> dict:
+    """The fallback "local refinement" (see FALLBACKS)."""
+    import gmsh
+
+    t0 = time.perf_counter()
+    if geometry_in is not None:
+        classified = geometry_in
+    else:
+        if geometry_out is None:
+            raise SystemExit("mesh_rod: local refinement needs --geometry-in or --geometry-out")
+        classified = geometry_out
+        gmsh.initialize(["mesh_rod"], readConfigFiles=False)
+        try:
+            gmsh.option.setNumber("General.Terminal", 0)
+            gmsh.merge(str(stl))
+            gmsh.model.mesh.classifySurfaces(math.radians(angle_deg), True, True, math.radians(curve_angle_deg))
+            gmsh.write(str(classified))
+        finally:
+            gmsh.finalize()
+    areas, centroids = patch_facts(classified)
+    field_data = read_size_field(size_field) if size_field is not None else None
+    refine: dict[int, float] = {}
+    errors = []
+    last = None
+    for rounds in range(LOCAL_ROUNDS + 1):
+        gmsh.initialize(["mesh_rod"], readConfigFiles=False)
+        try:
+            for k, v in gmsh_options(size_mm, False, size_field is not None).items():
+                gmsh.option.setNumber(k, v)
+            gmsh.option.setNumber("Mesh.Algorithm3D", 1)  # Delaunay: its errors name the surfaces
+            gmsh.model.add("rod")
+            gmsh.merge(str(classified))
+            gmsh.model.mesh.createGeometry()
+            surfaces = [tag for _, tag in gmsh.model.getEntities(2)]
+            loop = gmsh.model.geo.addSurfaceLoop(surfaces)
+            gmsh.model.geo.addVolume([loop])
+            gmsh.model.geo.synchronize()
+            size_field_tets, base = add_size_field(size_field, background=False) if size_field else (0, None)
+            if refine:
+                add_refinement(refine, size_mm, base)
+            elif base is not None:
+                gmsh.model.mesh.field.setAsBackgroundMesh(base)
+            t1 = time.perf_counter()
+            gmsh.logger.start()
+            try:
+                gmsh.model.mesh.generate(3)
+            except Exception as e:  # gmsh raises Exception with its last error
+                error = str(e)
+                errors.append(error)
+                messages = gmsh.logger.get()
+                for m in messages[-40:]:
+                    if re.search(r"(1st|2nd): ", m):
+                        log(f"    {m.strip()}")
+                named = [t for t in surfaces_named(error, messages) if t in areas]
+                log(f"  local refinement round {rounds}: {error}")
+                if not named:
+                    # TetGen's "PLC Error" names no entity: most likely near what was refined last
+                    named = [last] if last is not None else []
+                if not named:
+                    raise RuntimeError(f"local refinement: {error} (no surface named to refine)")
+                current = {t: refine.get(t, start_size(t, size_mm, field_data, centroids)) for t in named}
+                open_ = [t for t in named if current[t] * 0.5 >= LOCAL_MIN_SIZE_MM]
+                if not open_:
+                    raise RuntimeError(f"local refinement: {error} (sizes there already at "
+                                       f"{LOCAL_MIN_SIZE_MM} mm)")
+                patch = min(open_, key=lambda t: (areas[t], t))
+                refine[patch] = current[patch] * 0.5
+                last = patch
+                continue
+            t2 = time.perf_counter()
+            tags10, min_sj, min_sicn = tet10_qualities()
+            node_tags, _, _ = gmsh.model.mesh.getNodes()
+            gmsh.write(str(msh_out))
+            return {
+                "elements": int(tags10.size),
+                "gmsh_nodes": int(len(node_tags)),
+                "min_scaled_jacobian": float(min_sj.min()),
+                "mean_scaled_jacobian": float(min_sj.mean()),
+                "min_sicn": float(min_sicn.min()),
+                "mean_sicn": float(min_sicn.mean()),
+                "elements_sicn_below_0.1": int((min_sicn < 0.1).sum()),
+                "surface_patches": len(surfaces),
+                "size_field_tetrahedra": size_field_tets,
+                "algorithm_3d": "delaunay",
+                "geometry_reused": geometry_in is not None,
+                "fallback": "local refinement",
+                "fallback_detail": {
+                    "rounds": rounds,
+                    "refined_patches": [{"surface": t, "area_mm2": areas[t], "size_mm": h}
+                                        for t, h in sorted(refine.items())],
+                    "errors": errors,
+                },
+                "seconds_geometry": t1 - t0,
+                "seconds_mesh": t2 - t1,
+                "gmsh_version": gmsh.option.getString("General.Version"),
+            }
+        finally:
+            gmsh.finalize()
+    raise RuntimeError(f"local refinement: still failing after {LOCAL_ROUNDS} rounds: {errors[-1]}")
+
+
+def start_size(tag: int, size_mm: float, field_data, centroids: dict) -> float:
+    """The size a patch is meshed at before it is refined: the target, or with a size field the
+    field's size near the patch (at most the target)."""
+    if field_data is None:
+        return size_mm
+    return min(size_mm, field_size_near(field_data, centroids[tag]))
+
+
+def gmsh_surface_kept(stl: pathlib.Path, size_mm: float, msh_out: pathlib.Path,
+                      size_field: pathlib.Path | None) -> dict:
+    """The fallback "STL surface kept" (see FALLBACKS)."""
+    import gmsh
+
+    t0 = time.perf_counter()
+    gmsh.initialize(["mesh_rod"], readConfigFiles=False)
+    try:
+        for k, v in gmsh_options(size_mm, False, size_field is not None).items():
+            gmsh.option.setNumber(k, v)
+        gmsh.option.setNumber("Mesh.Algorithm3D", 1)
+        gmsh.model.add("rod")
+        gmsh.merge(str(stl))
+        surfaces = [tag for _, tag in gmsh.model.getEntities(2)]
+        loop = gmsh.model.geo.addSurfaceLoop(surfaces)
+        gmsh.model.geo.addVolume([loop])
+        gmsh.model.geo.synchronize()
+        size_field_tets = add_size_field(size_field)[0] if size_field is not None else 0
+        t1 = time.perf_counter()
+        gmsh.model.mesh.generate(3)
+        t2 = time.perf_counter()
+        tags10, min_sj, min_sicn = tet10_qualities()
+        node_tags, _, _ = gmsh.model.mesh.getNodes()
+        boundary = sum(len(t) for t in gmsh.model.mesh.getElements(2)[1])
+        gmsh.write(str(msh_out))
+        return {
+            "elements": int(tags10.size),
+            "gmsh_nodes": int(len(node_tags)),
+            "min_scaled_jacobian": float(min_sj.min()),
+            "mean_scaled_jacobian": float(min_sj.mean()),
+            "min_sicn": float(min_sicn.min()),
+            "mean_sicn": float(min_sicn.mean()),
+            "elements_sicn_below_0.1": int((min_sicn < 0.1).sum()),
+            "surface_patches": 0,
+            "size_field_tetrahedra": size_field_tets,
+            "algorithm_3d": "delaunay",
+            "geometry_reused": False,
+            "fallback": "STL surface kept",
+            "fallback_detail": {"boundary_triangles": int(boundary)},
+            "seconds_geometry": t1 - t0,
+            "seconds_mesh": t2 - t1,
+            "gmsh_version": gmsh.option.getString("General.Version"),
+        }
+    finally:
+        gmsh.finalize()
+
+
+def bond_shells(stl: pathlib.Path, out: pathlib.Path) -> int:
+    """Where an STL holds several shells that touch face to face (a rod and its cap exported as two
+    bodies: `mass` treats them as one bonded body), the touching faces come as pairs of the same
+    triangle with opposite orientations, and gmsh cannot classify the edges where four triangles
+    meet. Removing those pairs leaves the surface of the bonded body. Writes it to `out` (binary
+    STL) and returns the number of pairs removed; 0 (nothing written) for any other STL, or one
+    that is not binary."""
+    data = stl.read_bytes()
+    if len(data) < 84:
+        return 0
+    n = int.from_bytes(data[80:84], "little")
+    if len(data) != 84 + 50 * n or n == 0:
+        return 0
+    rec = np.frombuffer(data[84:], dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")]))
+    _, ids = np.unique(rec["v"].reshape(-1, 3), axis=0, return_inverse=True)
+    tri = ids.reshape(-1, 3)
+    # a triangle and its reverse: the same three vertices, opposite cyclic order
+    key = np.sort(tri, axis=1)
+    rot = np.argmin(tri, axis=1)
+    canon = np.stack([np.roll(t, -r) for t, r in zip(tri.tolist(), rot.tolist())])  # smallest first
+    forward = canon[:, 1] < canon[:, 2]
+    _, group, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    group = group.reshape(-1)
+    drop = np.zeros(n, dtype=bool)
+    for g in np.flatnonzero(counts == 2):
+        a, b = np.flatnonzero(group == g)
+        if forward[a] != forward[b]:
+            drop[[a, b]] = True
+    pairs = int(drop.sum()) // 2
+    if pairs:
+        kept = rec[~drop]
+        out.write_bytes(data[:80] + len(kept).to_bytes(4, "little") + kept.tobytes())
+    return pairs
+
+
+def run_fallback(name: str, stl: pathlib.Path, size: float, angle: float, curve_angle: float,
+                 msh: pathlib.Path, size_field, geometry_in, geometry_out) -> tuple[dict | None, str]:
+    """One fallback of FALLBACKS in a child process."""
+    cmd = [sys.executable, str(pathlib.Path(__file__).resolve()), "_fallback", name, str(stl), str(msh),
+           "--size", repr(size), "--angle", repr(angle), "--curve-angle", repr(curve_angle)]
+    for flag, value in (("--size-field", size_field), ("--geometry-in", geometry_in),
+                        ("--geometry-out", geometry_out)):
+        if value is not None:
+            cmd += [flag, str(value)]
+    return run_child(cmd)
 
 
 def cmd_mesh(args) -> dict:
@@ -287,6 +667,7 @@ def cmd_mesh(args) -> dict:
     msh = out_dir / f"{name}.msh"
     rodmesh = out_dir / f"{name}.rodmesh"
     t0 = time.perf_counter()
+    set_deadline(t0)
     size_field = pathlib.Path(args.size_field) if args.size_field else None
     if size_field is not None and not size_field.is_file():
         raise SystemExit(f"mesh_rod: no such size field file: {size_field}")
@@ -297,8 +678,9 @@ def cmd_mesh(args) -> dict:
     cached = None
     if geometry is not None and geometry.is_file() and meta.is_file():
         cached = json.loads(meta.read_text())
-        # the classification that worked is kept: a failure with it is reported at once (the
-        # caller asks again with smaller sizes rather than reclassifying six times)
+        # the classification that worked is kept: a failure with it goes to the fallbacks on that
+        # classification, then back to the caller (which asks again with smaller sizes rather
+        # than reclassifying six times)
         ladder = [(cached["classify_angle_deg"], cached["curve_angle_deg"])]
     failed = []
     info = None
@@ -331,9 +713,56 @@ def cmd_mesh(args) -> dict:
             break
         log(f"  failed: {why}")
         failed.append({"classify_angle_deg": angle, "curve_angle_deg": curve_angle, "error": why})
+        if out_of_time():
+            break
     if info is None:
-        raise SystemExit(f"mesh_rod: gmsh could not mesh {stl} at {args.size} mm with any of "
-                         f"{len(ladder)} settings: " + "; ".join(f["error"] for f in failed))
+        # the surface itself is meshed differently (FALLBACKS); the classification is the cached
+        # one or the ladder's first
+        angle, curve_angle = ladder[0]
+        # shells that touch face to face are bonded first (their common faces removed)
+        bonded = out_dir / f"{name}.bonded.stl"
+        pairs = bond_shells(stl, bonded)
+        if pairs:
+            log(f"{stl.name}: {pairs} pairs of coincident opposite triangles (shells touching face to face) "
+                "removed: the fallbacks mesh the bonded body")
+        surface = bonded if pairs else stl
+        for fallback in FALLBACKS:
+            reuse = cached is not None and not pairs
+            geo_out = None
+            if fallback == "local refinement" and not reuse:
+                geo_out = (geometry.with_name(geometry.name + ".tmp.msh") if geometry is not None
+                           else out_dir / f"{name}.classified.tmp.msh")
+            log(f"{stl.name}: every classification failed; fallback: {fallback}")
+            info, why = run_fallback(fallback, surface, args.size, angle, curve_angle, msh, size_field,
+                                     geometry if reuse else None, geo_out)
+            if info is not None:
+                if pairs:
+                    info["fallback"] = f"shells bonded, {fallback}"
+                    info["fallback_detail"]["coincident_triangle_pairs_removed"] = pairs
+                info.update({"classify_angle_deg": angle if fallback == "local refinement" else 0.0,
+                             "curve_angle_deg": curve_angle if fallback == "local refinement" else 0.0,
+                             "curved": False})
+                if geometry is not None and geo_out is not None and geo_out.is_file():
+                    geo_out.replace(geometry)
+                    meta.write_text(json.dumps({"classify_angle_deg": angle, "curve_angle_deg": curve_angle}))
+            if geo_out is not None and geo_out.is_file():
+                geo_out.unlink()
+            if info is not None:
+                break
+            log(f"  failed: {why}")
+            failed.append({"fallback": f"shells bonded, {fallback}" if pairs else fallback, "error": why})
+        if bonded.is_file():
+            bonded.unlink()
+    if info is None:
+        ladder_errors = [f["error"] for f in failed if "fallback" not in f]
+        tried = [f"the classification ladder ({len(ladder_errors)} of {len(ladder)} settings tried, "
+                 f"last error: {ladder_errors[-1] if ladder_errors else 'none'})"]
+        tried += [f"{f['fallback']} ({'' if f['error'].startswith('not tried') else 'error: '}{f['error']})"
+                  for f in failed if "fallback" in f]
+        tried += [f"{fb} (not tried: the mesher's time limit)" for fb in FALLBACKS
+                  if not any(f.get("fallback", "").endswith(fb) for f in failed)]
+        raise SystemExit(f"mesh_rod: error: gmsh could not mesh {stl} at {args.size} mm; tried "
+                         + "; ".join(tried) + f"; {WHAT_TO_TRY}")
     conv = convert(msh, rodmesh, "mm")
     info.update({
         "stl": str(stl),
@@ -343,6 +772,7 @@ def cmd_mesh(args) -> dict:
         "nodes": conv["nodes"],
         "max_midside_offset_rel": conv["max_midside_offset_rel"],
         "failed_attempts": failed,
+        "fallback": info.get("fallback"),
         "seconds_total": time.perf_counter() - t0,
     })
     if conv["elements"] != info["elements"]:
@@ -381,17 +811,11 @@ def gmsh_step_mesh(step: pathlib.Path, frame: list, scale: float, size_mm: float
         a = np.hstack([scale * r, (-scale * r @ o).reshape(3, 1)])
         occ.affineTransform(solids, a.reshape(-1).tolist())
         occ.synchronize()
-        size_field_tets = add_size_field(size_field) if size_field is not None else 0
+        size_field_tets = add_size_field(size_field)[0] if size_field is not None else 0
         t1 = time.perf_counter()
         gmsh.model.mesh.generate(3)
         t2 = time.perf_counter()
-        types, tags, _ = gmsh.model.mesh.getElements(3)
-        tet10 = [t for ty, t in zip(types, tags) if ty == 11]
-        if not tet10 or len(types) != 1:
-            raise RuntimeError(f"gmsh produced element types {list(types)}, expected only 10-node tets (11)")
-        tags10 = np.asarray(tet10[0])
-        min_sj = np.asarray(gmsh.model.mesh.getElementQualities(tags10, "minSJ"))
-        min_sicn = np.asarray(gmsh.model.mesh.getElementQualities(tags10, "minSICN"))
+        tags10, min_sj, min_sicn = tet10_qualities()
         if min_sj.min() <= 0.0:
             raise RuntimeError(f"{int((min_sj <= 0).sum())} curved element(s) still inverted after gmsh's "
                                f"high-order optimiser (min scaled Jacobian {min_sj.min():.3g}): not solved on")
@@ -460,6 +884,18 @@ def cmd_attempt(args) -> dict:
     return gmsh_volume_mesh(pathlib.Path(args.stl), args.size, args.curved, args.angle, args.curve_angle,
                             pathlib.Path(args.msh), path(args.size_field), path(args.geometry_in),
                             path(args.geometry_out), args.delaunay)
+
+
+def cmd_fallback(args) -> dict:
+    """Internal: one fallback of FALLBACKS, writing the .msh; used by `mesh` in a child process."""
+    path = lambda v: pathlib.Path(v) if v else None  # noqa: E731
+    if args.strategy == "local refinement":
+        return gmsh_local_refinement(pathlib.Path(args.stl), args.size, args.angle, args.curve_angle,
+                                     pathlib.Path(args.msh), path(args.size_field), path(args.geometry_in),
+                                     path(args.geometry_out))
+    if args.strategy == "STL surface kept":
+        return gmsh_surface_kept(pathlib.Path(args.stl), args.size, pathlib.Path(args.msh), path(args.size_field))
+    raise SystemExit(f"mesh_rod: unknown fallback {args.strategy!r}")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -561,6 +997,16 @@ def main(argv=None) -> int:
     pa.add_argument("--geometry-in")
     pa.add_argument("--geometry-out")
     pa.add_argument("--delaunay", action="store_true")
+    pf = sub.add_parser("_fallback", help=argparse.SUPPRESS)
+    pf.add_argument("strategy", choices=FALLBACKS)
+    pf.add_argument("stl")
+    pf.add_argument("msh")
+    pf.add_argument("--size", type=float, required=True)
+    pf.add_argument("--angle", type=float, required=True)
+    pf.add_argument("--curve-angle", type=float, required=True)
+    pf.add_argument("--size-field")
+    pf.add_argument("--geometry-in")
+    pf.add_argument("--geometry-out")
     ps = sub.add_parser("mesh-step", help="STEP solid -> curved tet10 in the rod frame (.msh + .rodmesh)")
     ps.add_argument("step")
     ps.add_argument("out_dir")
@@ -577,7 +1023,7 @@ def main(argv=None) -> int:
     pc.add_argument("--units", default="mm", help="units of the input coordinates: mm (default) or m")
     args = ap.parse_args(argv)
     info = {"mesh": cmd_mesh, "mesh-step": cmd_mesh_step, "convert": cmd_convert,
-            "_attempt": cmd_attempt}[args.cmd](args)
+            "_attempt": cmd_attempt, "_fallback": cmd_fallback}[args.cmd](args)
     print(json.dumps(info, sort_keys=True))
     return 0
 

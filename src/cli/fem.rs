@@ -228,6 +228,11 @@ fn print_result(d: &DesignFem) {
         f.loaded_bore.radius_mm,
         f.fixed_bore.radius_mm
     );
+    if let Some(fallback) = &d.mesh.fallback {
+        println!(
+            "mesh fallback: {fallback} (gmsh could not mesh the reparametrised surface as classified)"
+        );
+    }
     println!(
         "\n| case | max von Mises unaveraged [MPa] | averaged [MPa] | away from fixed bore [MPa] (judged) | max displacement [mm] | resultant error | reaction balance |\n|---|---|---|---|---|---|---|"
     );

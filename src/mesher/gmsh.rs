@@ -4,7 +4,8 @@
 //! The script prints progress on standard error and one JSON line on standard output, which is
 //! parsed into [`MeshReport`]. gmsh's remeshing of a surface reconstructed from an STL can fail where
 //! tiny faces meet large ones; the script then tries a fixed ladder of classification settings
-//! (reported in `classify_angle_deg`, `curve_angle_deg`, `failed_attempts`), so the result stays
+//! (reported in `classify_angle_deg`, `curve_angle_deg`, `failed_attempts`), and where every
+//! setting fails, fallbacks that mesh the surface differently (`fallback`), so the result stays
 //! deterministic.
 
 use std::path::{Path, PathBuf};
@@ -40,9 +41,14 @@ pub struct MeshReport {
     /// Curve split angle of the classification that succeeded, degrees.
     #[serde(default)]
     pub curve_angle_deg: f64,
-    /// Classification settings tried before and why they failed (gmsh errors or crashes).
+    /// Classification settings (and fallbacks) tried before and why they failed (gmsh errors or
+    /// crashes).
     #[serde(default)]
     pub failed_attempts: Vec<serde_json::Value>,
+    /// The fallback that made the mesh where every classification setting failed: `local
+    /// refinement` or `STL surface kept` (`mesh_rod.py`'s `FALLBACKS`); `None` for the usual mesh.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fallback: Option<String>,
     /// The gmsh mesh written (MSH 4.1).
     pub msh: PathBuf,
     /// The hand-off file read.

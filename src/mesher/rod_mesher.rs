@@ -28,6 +28,9 @@ pub struct GmshRodMesher {
     label: String,
     /// The report of the last mesh made.
     pub last_report: Option<MeshReport>,
+    /// The meshes that needed one of the mesher's fallbacks: `<fallback>` for the fixed mesh,
+    /// `mesh <iteration>: <fallback>` for an adaptive one.
+    pub fallbacks: Vec<String>,
 }
 
 impl GmshRodMesher {
@@ -55,6 +58,7 @@ impl GmshRodMesher {
             work_dir: work_dir.to_path_buf(),
             label: label.to_string(),
             last_report: None,
+            fallbacks: Vec::new(),
         })
     }
 
@@ -116,6 +120,7 @@ impl GmshRodMesher {
     /// The one fixed-size mesh of stage 3 (`work_dir/fixed`).
     pub fn fixed(&mut self, size_mm: f64) -> Result<MeshedRod> {
         let meshed = self.mesh_into(size_mm, None, &self.work_dir.join("fixed"))?;
+        self.fallbacks.extend(meshed.report.fallback.clone());
         self.last_report = Some(meshed.report.clone());
         Ok(meshed)
     }
@@ -123,8 +128,9 @@ impl GmshRodMesher {
 
 impl Mesher for GmshRodMesher {
     /// The mesh the adaptive loop asks for, in `work_dir/adapt<iteration>`. gmsh can fail to
-    /// remesh a faceted surface coarsely where thin features meet ("overlapping facets"): a
-    /// failed mesh is asked again with all sizes × 0.8, twice at most.
+    /// remesh a faceted surface coarsely where thin features meet ("overlapping facets"); the
+    /// mesher then tries its fallbacks (`mesh_rod.py`'s `FALLBACKS`), and a mesh that still fails
+    /// is asked again with all sizes × 0.8, twice at most.
     fn mesh(&mut self, ask: &MeshAsk<'_>) -> Result<(TetMesh, f64)> {
         let dir = self.work_dir.join(format!("adapt{}", ask.iteration));
         std::fs::create_dir_all(&dir)
@@ -158,6 +164,9 @@ impl Mesher for GmshRodMesher {
             }
         };
         let secs = meshed.report.seconds_wall.max(meshed.report.seconds_total);
+        if let Some(f) = &meshed.report.fallback {
+            self.fallbacks.push(format!("mesh {}: {f}", ask.iteration));
+        }
         self.last_report = Some(meshed.report);
         Ok((meshed.mesh, secs))
     }

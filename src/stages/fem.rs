@@ -361,6 +361,11 @@ impl Setup {
     }
 }
 
+/// The mesher's fallbacks of a run, for `mesh.fallback` (`None` when no mesh needed one).
+fn joined(fallbacks: &[String]) -> Option<String> {
+    (!fallbacks.is_empty()).then(|| fallbacks.join("; "))
+}
+
 /// Stage 3 on one gmsh mesh of uniform size `size_mm` (the thesis' setting is 5 mm).
 pub fn fem_fixed(
     design: &LoadedDesign,
@@ -395,6 +400,7 @@ pub fn fem_fixed(
         frame: FRAME.into(),
         adaptive: None,
         surface_triangles: setup.surface_triangles(),
+        fallback: joined(&mesher.fallbacks),
     };
     Ok(setup.outcome(force_n, config, summary, meshed.mesh, solution))
 }
@@ -475,6 +481,7 @@ pub fn fem_adaptive(
             monotone: out.monotone,
         }),
         surface_triangles: setup.surface_triangles(),
+        fallback: joined(&mesher.fallbacks),
     };
     Ok(setup.outcome(force_n, config, summary, out.mesh, out.solution))
 }
@@ -530,6 +537,7 @@ pub fn fem_user_mesh(
         frame: FRAME.into(),
         adaptive: None,
         surface_triangles: setup.surface_triangles(),
+        fallback: None,
     };
     Ok(setup.outcome(force_n, config, summary, mesh, solution))
 }

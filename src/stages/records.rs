@@ -89,6 +89,11 @@ pub struct MeshSummary {
     /// Triangles of the STL export and of the surface given to gmsh after simplification.
     #[serde(default)]
     pub surface_triangles: [usize; 2],
+    /// The mesher's fallback, where every classification of the surface failed (`local
+    /// refinement`, `STL surface kept`; adaptive: `mesh <iteration>: …` per mesh that needed
+    /// one, joined by "; "); absent for the usual mesh.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fallback: Option<String>,
 }
 
 /// How an adaptive sequence went.

@@ -87,7 +87,10 @@ pub fn one_line(message: &str, log_name: &str) -> Option<String> {
         .find(|l| l.contains("Error") || l.contains("error"))
         .unwrap_or(rest.last().expect("not empty"))
         .trim();
-    let hint = if message.contains("mesh_rod.py") || message.contains("gmsh") {
+    // the mesher's own last line lists what it tried and what to try
+    let hint = if cause.contains("try:") {
+        ""
+    } else if message.contains("mesh_rod.py") || message.contains("gmsh") {
         " — try: a fixed mesh (`fem.target_error = 0` or `--size`), a coarser or finer STL export, or a STEP export of the part"
     } else {
         ""
@@ -128,6 +131,11 @@ mod tests {
             line.contains("try:") && line.contains("x/failure.log"),
             "{line}"
         );
+        // the mesher's total failure says itself what to try: no second hint
+        let msg = "designs/x.stl: FEM: .venv/bin/python pipeline/mesh_rod.py exited with exit status: 1:\nmesh_rod:   failed: Exception: PLC Error\nmesh_rod: error: gmsh could not mesh x.stl at 8 mm; tried A; B; try: a STEP export";
+        let line = one_line(msg, "x/failure.log").unwrap();
+        assert_eq!(line.matches("try:").count(), 1, "{line}");
+        assert!(line.contains("tried A; B"), "{line}");
         // a one-line message stays as it is
         assert_eq!(one_line("x.stl: not an STL file", "x/failure.log"), None);
     }
