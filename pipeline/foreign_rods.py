@@ -12,10 +12,17 @@ bore finder, the validator and the mass stage meet what real CAD exports look li
                (two shells in the STL, two solids in the STEP)
   inches       a rod drawn in inches, its pin axis along y (sidecar: units = "in" only)
   plain        a rod like the designs (bores R25 / R12.5, 180 mm apart along x, pins along z)
+  stepped      the plain rod (shank 16 mm thick between 40 mm eyes) with every re-entrant edge an R1
+               fillet (the shank-to-eye junctions and the steps from the shank faces to the eyes),
+               also exported as NAME_chord.stl: 24 elements per turn but none below 0.8 mm, as an
+               export with a minimum facet size (or a 0.1 mm chord tolerance) cuts a small fillet:
+               each R1 fillet in two facets, kinks of 45°, above a 40° feature angle (issue 18
+               item 5: a fillet, not a sharp edge)
 
 Each rod is built with gmsh's OpenCASCADE kernel (as `make_designs.py` and `fillet_rod.py`) and
 written as NAME.step (the exact B-rep) and as binary STL at two chord tolerances: NAME_coarse.stl
-(24 elements per turn of curvature) and NAME_fine.stl (120 per turn), each surface mesh welded by
+(24 elements per turn of curvature) and NAME_fine.stl (120 per turn; the stepped rod also
+NAME_chord.stl, see above), each surface mesh welded by
 float32 value and oriented outward body by body (make_designs' orient_outward and validate_mesh,
 per solid). manifest.json holds, per rod: units, the true pin centres (file units), radii and pin
 axis, the arc of bore A, the exact volume, centre of mass and inertia matrix from OCC
@@ -61,7 +68,12 @@ TOLERANCES = {
                "Mesh.MeshSizeExtendFromBoundary": 0},
     "fine": {"Mesh.MeshSizeFromCurvature": 120, "Mesh.MeshSizeMin": 0.3, "Mesh.MeshSizeMax": 5.0,
              "Mesh.MeshSizeExtendFromBoundary": 0},
+    "chord": {"Mesh.MeshSizeFromCurvature": 24, "Mesh.MeshSizeMin": 0.8, "Mesh.MeshSizeMax": 10.0,
+              "Mesh.MeshSizeExtendFromBoundary": 0},
 }
+
+# The exports of each rod (default: coarse and fine).
+EXPORTS = {"stepped": ["coarse", "fine", "chord"]}
 
 MM_PER = {"mm": 1.0, "in": 25.4}
 
@@ -106,6 +118,26 @@ def rod_body(L, bore_a, bore_b, eye_a, eye_b, T, half_a, half_b, Ts, junction_r,
     return body
 
 
+def fillet_reentrant(body: int, L, eye_a, eye_b, Ts, r) -> int:
+    """`body` (a rod of `rod_body` without junction fillets and bores) with its re-entrant edges
+    filleted with radius r: the z-parallel shank-to-eye junctions and the arcs where the shank's
+    faces z = +-Ts/2 meet the eye walls."""
+    occ = gmsh.model.occ
+    occ.synchronize()
+    edges = [c for c, _, _ in md.z_parallel_edges(body)]
+    faces = gmsh.model.getBoundary([(3, body)], combined=False, oriented=False)
+    for c in sorted({abs(c) for _, c in gmsh.model.getBoundary(faces, combined=False, oriented=False)}):
+        x0, y0, z0, x1, y1, z1 = occ.getBoundingBox(1, c)
+        if abs(z1 - z0) < 1e-6 and abs(abs(z0) - Ts / 2) < 1e-6:
+            lo, hi = gmsh.model.getParametrizationBounds(1, c)
+            p = gmsh.model.getValue(1, c, [0.5 * (lo[0] + hi[0])])
+            if abs(math.hypot(p[0], p[1]) - eye_a) < 1e-3 or abs(math.hypot(p[0] - L, p[1]) - eye_b) < 1e-3:
+                edges.append(c)
+    out = occ.fillet([body], edges, [r])
+    assert len(out) == 1, "re-entrant fillets failed"
+    return out[0][1]
+
+
 def half_space(x_min: float, x_max: float, size: float) -> int:
     """A box x_min <= x <= x_max, large in y and z."""
     return gmsh.model.occ.addBox(x_min, -size, -size, x_max - x_min, 2 * size, 2 * size)
@@ -121,6 +153,16 @@ def build(name: str):
         v = rod_body(180, 25, 12.5, 45, 24, 40, 16, 11, 16, 8, 0)
         facts = dict(units="mm", crank=[0, 0, 0], piston=[180, 0, 0], ra=25, rb=12.5, axis=z, arc_a=360)
         return [v], facts
+    if name == "stepped":
+        body = rod_body(180, 25, 12.5, 45, 24, 40, 16, 11, 16, 0, 0, bores=False)
+        body = fillet_reentrant(body, 180, 45, 24, 16, 1.0)
+        ba = occ.addCylinder(0, 0, -40, 0, 0, 80, 25)
+        bb = occ.addCylinder(180, 0, -40, 0, 0, 80, 12.5)
+        out, _ = occ.cut([(3, body)], [(3, ba), (3, bb)])
+        assert len(out) == 1, f"bores cut gave {out}"
+        occ.synchronize()
+        facts = dict(units="mm", crank=[0, 0, 0], piston=[180, 0, 0], ra=25, rb=12.5, axis=z, arc_a=360)
+        return [out[0][1]], facts
     if name == "fillets":
         v = rod_body(200, 26, 13, 48, 25, 30, 17, 12, 30, 12, 1.0)
         occ.rotate([(3, v)], 0, 0, 0, 0, 0, 1, math.pi / 2)  # A -> B along +y
@@ -153,7 +195,7 @@ def build(name: str):
     raise ValueError(f"unknown rod {name!r}")
 
 
-RODS = ["fillets", "capless", "rod_and_cap", "inches", "plain"]
+RODS = ["fillets", "capless", "rod_and_cap", "inches", "plain", "stepped"]
 
 
 def mesh_volumes(volumes, tolerance: str, units: str):
@@ -238,7 +280,7 @@ def write_rod(name: str, out: pathlib.Path) -> dict:
     entry = {"units": facts["units"], "crank_pin": facts["crank"], "piston_pin": facts["piston"],
              "crank_bore_radius": facts["ra"], "piston_bore_radius": facts["rb"], "pin_axis": facts["axis"],
              "crank_bore_arc_deg": facts["arc_a"], "step": f"{name}.step", "exact": exact, "stl": {}}
-    for tol in TOLERANCES:
+    for tol in EXPORTS.get(name, ["coarse", "fine"]):
         verts, tris = mesh_volumes(volumes, tol, facts["units"])
         file = f"{name}_{tol}.stl"
         (out / file).write_bytes(md.stl_bytes(verts, tris, f"rodstudy foreign rod {name} {tol}, {facts['units']}"))

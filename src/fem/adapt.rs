@@ -396,6 +396,7 @@ pub fn adaptive_rod(
                 .enumerate()
             {
                 case.estimated_error_rel = estimates[c];
+                case.estimated_discretisation_error_rel = estimates[c];
                 case.adaptive = steps[c].clone();
             }
             solution.result.total_s = t_all.elapsed().as_secs_f64();

@@ -45,6 +45,7 @@ pub mod refinement;
 pub mod rod;
 pub mod rod_buckling;
 pub mod shape;
+pub mod smooth;
 pub mod solver;
 pub mod statics;
 pub mod stress;

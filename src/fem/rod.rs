@@ -22,7 +22,7 @@ use super::material::Material;
 use super::mesh::TetMesh;
 use super::recovery::recover_stress;
 use super::statics::{
-    FactorisedSystem, StaticProblem, Timings, solve_static, solve_static_keeping,
+    FactorisedSystem, StaticProblem, Timings, solve_static, solve_static_reusing,
 };
 use super::stress::{
     StressField, displacement_magnitudes, nodes_away_from, nodes_away_from_segments, peak_nodal,
@@ -62,6 +62,15 @@ pub struct RodOptions {
     /// (its supports are stage 3's), which then neither assembles nor factorises K again.
     #[serde(skip)]
     pub keep_system: bool,
+    /// Edges of the geometry at or above the feature angle taken for kinks of faceted small
+    /// fillets (refined like any curved surface, not excluded; [`super::facets::SurfaceEdges`]),
+    /// for the record.
+    #[serde(default)]
+    pub fillet_kink_edges: usize,
+    /// The symbolic analysis of another solve of K's pattern (the same mesh with its boundary moved:
+    /// the geometry check of [`super::smooth`]), reused where it fits.
+    #[serde(skip)]
+    pub reuse_symbolic: Option<super::solver::SymbolicFactor>,
 }
 
 /// Results of one load case. Stresses in MPa, lengths in mm, forces in N.
@@ -104,9 +113,23 @@ pub struct LoadCaseResult {
     /// ‖K u − f‖ / ‖f‖ over the free DOFs.
     pub solve_residual_rel: f64,
     /// Estimated relative error of `max_von_mises_away_from_fixed_mpa` (the judged peak): the
-    /// recovery estimate on one mesh, the goal-oriented one over an adaptive sequence (see
-    /// `error_estimate` and `adaptive`).
+    /// discretisation part plus the geometry part (a bound: the two are not independent random
+    /// errors, and where both lower the peak they add).
     pub estimated_error_rel: f64,
+    /// The discretisation part: the single-mesh bound on one mesh, the goal-oriented estimate over
+    /// an adaptive sequence (see `error_estimate` and `adaptive`).
+    #[serde(default)]
+    pub estimated_discretisation_error_rel: f64,
+    /// The geometry part: what the facets of an STL do to the judged peak, |P_smooth − P| / P with
+    /// P_smooth the judged peak of the same mesh curved onto a smooth surface through the STL's
+    /// vertices (`smooth_surface_peak_mpa`); 0 on the exact geometry of a STEP; `None` where it is
+    /// not estimated (a user's mesh, whose geometry is its own).
+    #[serde(default)]
+    pub estimated_geometry_error_rel: Option<f64>,
+    /// The judged peak of the same mesh curved onto the smooth surface through the STL's vertices
+    /// (see `estimated_geometry_error_rel`), MPa.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub smooth_surface_peak_mpa: Option<f64>,
     /// The recovery-based (Zienkiewicz–Zhu) estimates on this mesh.
     pub error_estimate: EstimateSummary,
     /// The adaptive sequence that led to this mesh (empty for a fixed mesh).
@@ -225,6 +248,18 @@ pub struct FemResult {
     /// Band around them excluded from the judged peak, mm.
     #[serde(default)]
     pub singular_band_mm: f64,
+    /// Edges at or above the feature angle taken for kinks of faceted small fillets (a chain of
+    /// facets turning about a small radius): refined, not excluded.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub fillet_kink_edges: usize,
+    /// What the figures need said beside them: a band around sharp edges that holds a stress
+    /// above the judged peak (the exclusion decides the judged figure).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
+    /// The second solve of an STL design's geometry error: its mesh curved onto the smooth surface
+    /// through the STL's vertices ([`super::smooth`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub geometry_check: Option<super::smooth::GeometryCheckRecord>,
     /// How the pin force is spread over the loaded bore (absent: uniform; `cosine`: a cosine
     /// bearing pressure on the pressed half).
     #[serde(default, skip_serializing_if = "BoreLoad::is_uniform")]
@@ -237,6 +272,10 @@ pub struct FemResult {
     pub timings: Timings,
     /// Total wall time of the analysis, s.
     pub total_s: f64,
+}
+
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 /// Full fields of a rod analysis (for post-processing beyond the figures).
@@ -326,9 +365,9 @@ pub fn solve_rod_fields(
         loads: loads.iter().map(|l| l.forces.clone()).collect(),
         quadrature: options.quadrature,
     };
-    let (sol, system) = if options.keep_system {
-        let (sol, system) = solve_static_keeping(&problem)?;
-        (sol, Some(Arc::new(system)))
+    let (sol, system) = if options.keep_system || options.reuse_symbolic.is_some() {
+        let (sol, system) = solve_static_reusing(&problem, options.reuse_symbolic.as_ref())?;
+        (sol, options.keep_system.then(|| Arc::new(system)))
     } else {
         (solve_static(&problem)?, None)
     };
@@ -356,6 +395,14 @@ pub fn solve_rod_fields(
             (false, false) => (band / 3.0).max(singular_band / 3.0),
         })
         .collect();
+    // the nodes left out for a sharp edge alone (not for the fixed bore)
+    let in_edge_band: Vec<bool> = away_fixed
+        .iter()
+        .zip(&away_edges)
+        .map(|(f, e)| *f && !*e)
+        .collect();
+    let any_in_edge_band = in_edge_band.iter().any(|b| *b);
+    let mut warnings = Vec::new();
     let mut results = Vec::new();
     let mut fields = Vec::new();
     let mut estimates = Vec::new();
@@ -383,6 +430,18 @@ pub fn solve_rod_fields(
             )));
         }
         let mm = |p: [f64; 3]| p.map(|v| v * 1e3);
+        if any_in_edge_band {
+            let hidden = peak_nodal(mesh, &vm_avg, Some(&in_edge_band));
+            if hidden.value > away_av.value {
+                warnings.push(edge_band_warning(
+                    name,
+                    &hidden,
+                    away_av.value,
+                    &options.singular_edges_m,
+                    singular_band,
+                ));
+            }
+        }
         results.push(LoadCaseResult {
             name: name.to_string(),
             direction: *dir,
@@ -403,6 +462,9 @@ pub fn solve_rod_fields(
             reaction_balance_rel: bal,
             solve_residual_rel: sol.residual_rel[c],
             estimated_error_rel: estimate.summary.single_mesh_estimate(),
+            estimated_discretisation_error_rel: estimate.summary.single_mesh_estimate(),
+            estimated_geometry_error_rel: None,
+            smooth_surface_peak_mpa: None,
             error_estimate: estimate.summary,
             adaptive: Vec::new(),
             vtu: None,
@@ -431,6 +493,9 @@ pub fn solve_rod_fields(
         fixed_band_mm: band * 1e3,
         singular_edges: options.singular_edges_m.len(),
         singular_band_mm: singular_band * 1e3,
+        fillet_kink_edges: options.fillet_kink_edges,
+        warnings,
+        geometry_check: None,
         bore_load: bores.bore_load,
         loaded_bore: (&loaded).into(),
         fixed_bore: (&fixed).into(),
@@ -460,6 +525,35 @@ pub fn solve_rod_fields(
         system,
     };
     Ok(solution)
+}
+
+/// The warning of a band around sharp edges that holds the highest stress of its neighbourhood,
+/// above the judged peak `judged_pa` of case `name`: where, how far from the nearest edge, by how
+/// much.
+fn edge_band_warning(
+    name: &str,
+    hidden: &super::stress::Peak,
+    judged_pa: f64,
+    edges: &[[[f64; 3]; 2]],
+    band: f64,
+) -> String {
+    let d = edges
+        .iter()
+        .map(|s| super::stress::point_segment_distance(hidden.location_m, *s))
+        .fold(f64::INFINITY, f64::min);
+    let p = hidden.location_m.map(|v| v * 1e3);
+    format!(
+        "{}: the {:.1} mm band around the sharp re-entrant edges holds the highest stress of its neighbourhood, {:.1} MPa at ({:.1}, {:.1}, {:.1}) mm, {:.2} mm from the nearest edge, {:.0} % above the judged peak {:.1} MPa: left out as a singularity; if that edge is rounded in the real part (a fillet the export cut into few facets), the peak is there (a STEP export settles it)",
+        if name == "fx" { "F_x" } else { "F_y" },
+        band * 1e3,
+        hidden.value * 1e-6,
+        p[0],
+        p[1],
+        p[2],
+        d * 1e3,
+        100.0 * (hidden.value / judged_pa - 1.0),
+        judged_pa * 1e-6
+    )
 }
 
 /// The F_x case of [`solve_rod`] as supports and nodal forces: bore B fixed (all DOFs of its

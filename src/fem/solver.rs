@@ -21,6 +21,8 @@ use super::error::{FemError, Result};
 #[derive(Clone, Debug)]
 pub struct SymbolicFactor {
     inner: Arc<SymbolicCholesky<usize>>,
+    /// A fingerprint of the pattern analysed ([`fingerprint`]), to check a reuse.
+    pattern: u64,
 }
 
 impl SymbolicFactor {
@@ -36,6 +38,7 @@ impl SymbolicFactor {
         .map_err(|e| FemError::Solver(format!("symbolic Cholesky failed: {e:?}")))?;
         Ok(SymbolicFactor {
             inner: Arc::new(inner),
+            pattern: fingerprint(a),
         })
     }
 
@@ -44,10 +47,26 @@ impl SymbolicFactor {
         self.inner.nrows()
     }
 
+    /// Whether `a` has the pattern this analysis was made from (its dimension, and a fingerprint
+    /// of its upper-triangle structure).
+    pub fn matches(&self, a: &SparseSym) -> bool {
+        self.inner.nrows() == a.n && self.pattern == fingerprint(a)
+    }
+
     /// Number of stored entries of the factor L (fill-in included).
     pub fn nnz_l(&self) -> usize {
         self.inner.len_val()
     }
+}
+
+/// A 64-bit fingerprint of the pattern of `a` (FNV-1a over the column pointers and row indices).
+fn fingerprint(a: &SparseSym) -> u64 {
+    a.col_ptr
+        .iter()
+        .chain(&a.row_idx)
+        .fold(0xcbf2_9ce4_8422_2325u64, |h, &v| {
+            (h ^ v as u64).wrapping_mul(0x0000_0100_0000_01b3)
+        })
 }
 
 fn symbolic_ref(a: &SparseSym) -> SymbolicSparseColMatRef<'_, usize> {

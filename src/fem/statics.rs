@@ -98,6 +98,16 @@ pub fn solve_static(problem: &StaticProblem) -> Result<StaticSolution> {
 
 /// [`solve_static`], returning the factorised system too.
 pub fn solve_static_keeping(problem: &StaticProblem) -> Result<(StaticSolution, FactorisedSystem)> {
+    solve_static_reusing(problem, None)
+}
+
+/// [`solve_static_keeping`] with the symbolic analysis (ordering, elimination tree) of another solve
+/// reused where K has its pattern (the same mesh connectivity and supports: the same mesh with its
+/// boundary moved, [`super::smooth`]); analysed afresh where it does not.
+pub fn solve_static_reusing(
+    problem: &StaticProblem,
+    symbolic: Option<&SymbolicFactor>,
+) -> Result<(StaticSolution, FactorisedSystem)> {
     let mesh = problem.mesh;
     let n_dofs = mesh.n_dofs();
     if problem.loads.is_empty() {
@@ -119,7 +129,10 @@ pub fn solve_static_keeping(problem: &StaticProblem) -> Result<(StaticSolution, 
     timings.assembly_s = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
-    let symbolic = SymbolicFactor::analyse(&asm.k)?;
+    let symbolic = match symbolic {
+        Some(s) if s.matches(&asm.k) => s.clone(),
+        _ => SymbolicFactor::analyse(&asm.k)?,
+    };
     timings.symbolic_s = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let factor = CholeskyFactor::factorise(&symbolic, &asm.k)?;

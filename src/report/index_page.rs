@@ -53,6 +53,14 @@ pub fn index_html(results: &StudyResults, out: &Path) -> String {
         escape(&ranking::explanation(results)),
         ranking::html_table(results)
     );
+    let warnings = ranking::fem_warnings(results);
+    if !warnings.is_empty() {
+        s.push_str("<h3>FEM warnings</h3>\n<ul>\n");
+        for (d, m) in warnings {
+            let _ = writeln!(s, "<li>{}: {}</li>", escape(&d), escape(&m));
+        }
+        s.push_str("</ul>\n");
+    }
     let notes = ranking::validity_notes(results);
     if !notes.is_empty() {
         let _ = write!(
@@ -213,6 +221,21 @@ fn design_section(s: &mut String, r: &RankRow, out: &Path) {
                 if c.pass { "pass" } else { "fail" }
             ),
         ));
+        props.push((
+            "error of the judged peaks",
+            format!(
+                "{}{}",
+                [&f.fem.fy, &f.fem.fx].map(ranking::error_split).join("; "),
+                if f.fem.fy.smooth_surface_peak_mpa.is_some() {
+                    "; a STEP export of the design removes the geometry part"
+                } else {
+                    ""
+                }
+            ),
+        ));
+        for w in &f.fem.warnings {
+            props.push(("FEM warning", w.clone()));
+        }
         let mesh = &f.mesh;
         props.push((
             "FEM mesh",

@@ -522,6 +522,73 @@ pub fn validity_notes(results: &StudyResults) -> Vec<(String, String)> {
         .collect()
 }
 
+/// What the error bar of a case's judged peak is made of, in words: the discretisation part, the
+/// geometry part (an STL's facets) and which dominates.
+pub fn error_split(case: &crate::fem::LoadCaseResult) -> String {
+    let label = if case.name == "fx" { "F_x" } else { "F_y" };
+    let d = case.estimated_discretisation_error_rel;
+    let head = format!(
+        "{label} {:.1} MPa ± {:.1} %",
+        case.max_von_mises_away_from_fixed_mpa,
+        100.0 * case.estimated_error_rel
+    );
+    match case.estimated_geometry_error_rel {
+        None => format!("{head} (discretisation; geometry not estimated)"),
+        Some(g) if g == 0.0 && case.smooth_surface_peak_mpa.is_none() => {
+            format!("{head} (discretisation alone: the exact geometry)")
+        }
+        Some(g) => format!(
+            "{head} = {:.1} % discretisation + {:.1} % geometry (the STL's facets): {} dominates",
+            100.0 * d,
+            100.0 * g,
+            if g > d {
+                "the geometry"
+            } else {
+                "the discretisation"
+            }
+        ),
+    }
+}
+
+/// Per design, the error bars of its judged peaks split into discretisation and geometry.
+pub fn error_notes(results: &StudyResults) -> Vec<(String, String)> {
+    ranking(results)
+        .into_iter()
+        .filter_map(|r| r.fem.map(|f| (r.mass.design.clone(), f)))
+        .map(|(d, f)| {
+            let cases = [&f.fem.fy, &f.fem.fx].map(error_split).join("; ");
+            let stl = f.fem.fy.smooth_surface_peak_mpa.is_some()
+                || f.fem.fx.smooth_surface_peak_mpa.is_some();
+            (
+                d,
+                if stl {
+                    format!("{cases}. A STEP export of the design removes the geometry part.")
+                } else {
+                    format!("{cases}.")
+                },
+            )
+        })
+        .collect()
+}
+
+/// The sentence above the error list.
+pub const ERROR_PREAMBLE: &str = "The estimated error of each judged peak is the sum of two parts (a bound: where both lower or both raise the peak they add): the discretisation (the mesh: the adaptive sequence's estimate) and, for an STL, the geometry (what the facets do: the same mesh curved onto a smooth surface through the STL's vertices and solved again). A STEP design is meshed on its exact geometry with curved elements: no geometry part.";
+
+/// Per design, the warnings of its FEM record.
+pub fn fem_warnings(results: &StudyResults) -> Vec<(String, String)> {
+    ranking(results)
+        .into_iter()
+        .filter_map(|r| r.fem.map(|f| (r.mass.design.clone(), f)))
+        .flat_map(|(d, f)| {
+            f.fem
+                .warnings
+                .iter()
+                .map(move |w| (d.clone(), w.clone()))
+                .collect::<Vec<_>>()
+        })
+        .collect()
+}
+
 /// The sentence above the out-of-depth list.
 pub const VALIDITY_PREAMBLE: &str = "The stage-3 model is linear elastic and small-displacement; these figures are beyond it (the verdict stands, the numbers are not to be read as the part's stress or deflection):";
 
@@ -538,6 +605,22 @@ pub fn markdown(results: &StudyResults) -> String {
             .map(|c| c.replace('|', "\\|"))
             .collect();
         out.push_str(&format!("| {} |\n", cells.join(" | ")));
+    }
+    let errors = error_notes(results);
+    if !errors.is_empty() {
+        out.push_str(&format!(
+            "\n## Error of the judged peaks\n\n{ERROR_PREAMBLE}\n\n"
+        ));
+        for (d, m) in errors {
+            out.push_str(&format!("- {d}: {m}\n"));
+        }
+    }
+    let warnings = fem_warnings(results);
+    if !warnings.is_empty() {
+        out.push_str("\n## FEM warnings\n\n");
+        for (d, m) in warnings {
+            out.push_str(&format!("- {d}: {m}\n"));
+        }
     }
     let notes = validity_notes(results);
     if !notes.is_empty() {

@@ -28,10 +28,11 @@ use super::rod_surface::{RodFrameSurface, rod_frame_surface};
 use crate::config::{FemConfig, StudyConfig};
 use crate::fem::adapt::{AdaptOptions, adaptive_rod};
 use crate::fem::buckling::{BucklingMode, BucklingOptions, BucklingSolution};
-use crate::fem::facets::{FacetScale, reentrant_edges};
+use crate::fem::facets::{FacetScale, MAX_FILLET_RADIUS_MM, SurfaceEdges};
 use crate::fem::refinement::{RefinementStudy, refinement_study};
 use crate::fem::rod::{RodSolution, solve_rod_fields};
 use crate::fem::rod_buckling::rod_buckling;
+use crate::fem::smooth::{SmoothSurface, geometry_check};
 use crate::fem::statics::FactorisedSystem;
 use crate::fem::{BoreSpec, Material, RodOptions, TetMesh};
 use crate::mesher::{GmshRodMesher, MESHER_SCRIPT, MeshReport, StepInRodFrame, read_volume_mesh};
@@ -235,6 +236,10 @@ struct Setup {
     step: Option<StepInRodFrame>,
     bores: BoreSpec,
     material: Material,
+    /// The surface's edges: kinks, faceted small fillets, sharp edges.
+    edges: SurfaceEdges,
+    /// The caller keeps the factorised K of the final mesh (buckling on it).
+    keep_system: bool,
     singular_edges: Vec<[[f64; 3]; 2]>,
     rod: RodOptions,
     /// `<file>: FEM`, the context of every error.
@@ -258,17 +263,26 @@ impl Setup {
             .with_context(|| context.clone())?
             .and_then(|d| d.peak_transverse_n);
         let surface = rod_frame_surface(design, for_gmsh);
-        let singular_edges: Vec<[[f64; 3]; 2]> =
-            reentrant_edges(&surface.vertices, &surface.triangles, FEATURE_ANGLE_DEG)
-                .into_iter()
-                .map(|s| s.map(|p| p.map(|v| v * 1e-3)))
-                .collect();
+        let edges = SurfaceEdges::new(
+            &surface.vertices,
+            &surface.triangles,
+            FEATURE_ANGLE_DEG,
+            MAX_FILLET_RADIUS_MM,
+        );
+        let singular_edges: Vec<[[f64; 3]; 2]> = edges
+            .sharp_reentrant(&surface.vertices)
+            .into_iter()
+            .map(|s| s.map(|p| p.map(|v| v * 1e-3)))
+            .collect();
         let rod = RodOptions {
             fixed_band_m: Some(config.fem.fixed_band_mm * 1e-3),
             singular_edges_m: singular_edges.clone(),
             singular_band_m: Some(config.fem.singular_band_mm * 1e-3),
             fy_force_n,
-            keep_system,
+            // the STL route keeps the last solve's system: the geometry check reuses its symbolic
+            // analysis
+            keep_system: keep_system || (for_gmsh && design.format.step().is_none()),
+            fillet_kink_edges: edges.fillet_kinks(),
             ..RodOptions::default()
         };
         let step = design.format.step().map(|_| {
@@ -293,6 +307,8 @@ impl Setup {
             bores,
             surface,
             material: Material::from(&config.fem),
+            edges,
+            keep_system,
             singular_edges,
             rod,
             context,
@@ -356,6 +372,66 @@ impl Setup {
         }
     }
 
+    /// Splits each case's estimated error into its discretisation part (as estimated so far) and
+    /// its geometry part, and folds the two into `estimated_error_rel` (their sum: a bound). The
+    /// geometry part of a STEP design is 0 (the exact geometry, curved elements); of an STL, the
+    /// change of the judged peak when the same mesh is curved onto the smooth surface through the
+    /// STL's vertices ([`crate::fem::smooth`]).
+    fn add_geometry_error(&self, mesh: &TetMesh, solution: &mut RodSolution, force_n: f64) {
+        // the first solve's symbolic analysis serves the second; its factor is freed first unless
+        // the caller keeps it
+        let symbolic = solution
+            .system
+            .as_ref()
+            .map(|s| s.factor.symbolic().clone());
+        if !self.keep_system {
+            solution.system = None;
+        }
+        let r = &mut solution.result;
+        let peaks = [
+            r.fx.max_von_mises_away_from_fixed_mpa,
+            r.fy.max_von_mises_away_from_fixed_mpa,
+        ];
+        // per case: the geometry part (None: could not be estimated) and the smooth peak
+        let smooth: [(Option<f64>, Option<f64>); 2] = if self.step.is_some() {
+            [(Some(0.0), None); 2]
+        } else {
+            let surface = SmoothSurface::new(
+                &self.surface.vertices,
+                &self.surface.triangles,
+                &self.edges,
+                2.0,
+            );
+            let rod = RodOptions {
+                keep_system: false,
+                reuse_symbolic: symbolic,
+                ..self.rod.clone()
+            };
+            match geometry_check(mesh, &surface, &self.material, &self.bores, force_n, &rod) {
+                Ok(check) => {
+                    r.geometry_check = Some(check.record());
+                    std::array::from_fn(|c| {
+                        let p = check.peaks_mpa[c];
+                        (Some((p - peaks[c]).abs() / peaks[c]), Some(p))
+                    })
+                }
+                Err(e) => {
+                    r.warnings.push(format!(
+                        "the geometry error (what the STL's facets do to the judged peak) is unknown: the mesh curved onto the smooth surface through the STL's vertices could not be solved ({e}); the error bars are the discretisation's alone"
+                    ));
+                    [(None, None); 2]
+                }
+            }
+        };
+        for (case, (g, p)) in [&mut r.fx, &mut r.fy].into_iter().zip(smooth) {
+            let d = case.estimated_error_rel;
+            case.estimated_discretisation_error_rel = d;
+            case.estimated_geometry_error_rel = g;
+            case.smooth_surface_peak_mpa = p;
+            case.estimated_error_rel = d + g.unwrap_or(0.0);
+        }
+    }
+
     fn surface_triangles(&self) -> [usize; 2] {
         [self.surface.triangles_export, self.surface.triangles.len()]
     }
@@ -380,7 +456,7 @@ pub fn fem_fixed(
     let meshed = mesher
         .fixed(size_mm)
         .with_context(|| setup.context.clone())?;
-    let solution = solve_rod_fields(
+    let mut solution = solve_rod_fields(
         &meshed.mesh,
         &setup.material,
         &setup.bores,
@@ -388,6 +464,7 @@ pub fn fem_fixed(
         &setup.rod,
     )
     .with_context(|| setup.context.clone())?;
+    setup.add_geometry_error(&meshed.mesh, &mut solution, force_n);
     let r: &MeshReport = &meshed.report;
     let summary = MeshSummary {
         source: setup.source().into(),
@@ -417,12 +494,7 @@ pub fn fem_adaptive(
 ) -> Result<FemOutcome> {
     let setup = Setup::new(design, config, true, keep_system)?;
     let mut mesher = setup.mesher(work_dir)?;
-    let facets = FacetScale::new(
-        &setup.surface.vertices,
-        &setup.surface.triangles,
-        FEATURE_ANGLE_DEG,
-        2.0,
-    );
+    let facets = FacetScale::from_edges(&setup.edges, &setup.surface.vertices, 2.0);
     // an STL's facets set a floor below which refinement resolves the facets, not the part; the
     // exact geometry of a STEP has none
     let exact = setup.step.is_some();
@@ -453,6 +525,8 @@ pub fn fem_adaptive(
         &floor,
     )
     .with_context(|| setup.context.clone())?;
+    let mut out = out;
+    setup.add_geometry_error(&out.mesh, &mut out.solution, force_n);
     let r = mesher.last_report.expect("at least one mesh");
     let iterations = out.solution.result.fx.adaptive.len();
     let summary = MeshSummary {
@@ -474,7 +548,7 @@ pub fn fem_adaptive(
                 "none: the exact geometry (STEP); at least min_size_mm".into()
             } else {
                 format!(
-                    "the STL's local facet spacing on curved surfaces (kinks below {FEATURE_ANGLE_DEG}°), at least min_size_mm"
+                    "the STL's local facet spacing: the spacing of the nearest kink (below {FEATURE_ANGLE_DEG}°, or a kink of a faceted small fillet), at least min_size_mm"
                 )
             },
             facet_spacing_median_mm: if exact { 0.0 } else { facets.median_spacing() },
