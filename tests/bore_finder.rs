@@ -84,7 +84,7 @@ fn foreign_rods_against_their_manifest() {
     let dir = tempfile::tempdir().unwrap();
     let manifest = run_foreign_rods(dir.path());
     let rods = manifest.as_object().unwrap();
-    assert_eq!(rods.len(), 5);
+    assert_eq!(rods.len(), 6);
     for (name, rod) in rods {
         let mm = match rod["units"].as_str().unwrap() {
             "mm" => 1.0,
