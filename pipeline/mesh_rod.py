@@ -209,6 +209,24 @@ def add_size_field(path: pathlib.Path, background: bool = True) -> tuple[int, in
     return data.size // 16, field
 
 
+def written_mesh(qualities, msh_out: pathlib.Path) -> dict:
+    """Writes the model's mesh to `msh_out` and returns the figures every meshing route reports:
+    counts and the quality of the 10-node tetrahedra (`qualities` from `tet10_qualities`)."""
+    import gmsh
+    tags10, min_sj, min_sicn = qualities
+    node_tags, _, _ = gmsh.model.mesh.getNodes()
+    gmsh.write(str(msh_out))
+    return {
+        "elements": int(tags10.size),
+        "gmsh_nodes": int(len(node_tags)),
+        "min_scaled_jacobian": float(min_sj.min()),
+        "mean_scaled_jacobian": float(min_sj.mean()),
+        "min_sicn": float(min_sicn.min()),
+        "mean_sicn": float(min_sicn.mean()),
+        "elements_sicn_below_0.1": int((min_sicn < 0.1).sum()),
+    }
+
+
 def tet10_qualities() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The tags of the model's 10-node tetrahedra (the only elements of dimension 3 allowed) and
     their minSJ and minSICN."""
@@ -265,16 +283,8 @@ def gmsh_volume_mesh(stl: pathlib.Path, size_mm: float, curved: bool, angle_deg:
             # HXT can leave a sliver its optimiser does not remove; the caller retries with
             # Delaunay + Netgen, whose optimiser does
             raise RuntimeError(f"HXT left a sliver (min SICN {min_sicn.min():.2e} < {MIN_SICN})")
-        node_tags, _, _ = gmsh.model.mesh.getNodes()
-        gmsh.write(str(msh_out))
         return {
-            "elements": int(tags10.size),
-            "gmsh_nodes": int(len(node_tags)),
-            "min_scaled_jacobian": float(min_sj.min()),
-            "mean_scaled_jacobian": float(min_sj.mean()),
-            "min_sicn": float(min_sicn.min()),
-            "mean_sicn": float(min_sicn.mean()),
-            "elements_sicn_below_0.1": int((min_sicn < 0.1).sum()),
+            **written_mesh((tags10, min_sj, min_sicn), msh_out),
             "surface_patches": len(surfaces),
             "size_field_tetrahedra": size_field_tets,
             "algorithm_3d": {10: "hxt", 1: "delaunay"}.get(int(gmsh.option.getNumber("Mesh.Algorithm3D")), "?"),
@@ -522,17 +532,8 @@ def gmsh_local_refinement(stl: pathlib.Path, size_mm: float, angle_deg: float, c
                 last = patch
                 continue
             t2 = time.perf_counter()
-            tags10, min_sj, min_sicn = tet10_qualities()
-            node_tags, _, _ = gmsh.model.mesh.getNodes()
-            gmsh.write(str(msh_out))
             return {
-                "elements": int(tags10.size),
-                "gmsh_nodes": int(len(node_tags)),
-                "min_scaled_jacobian": float(min_sj.min()),
-                "mean_scaled_jacobian": float(min_sj.mean()),
-                "min_sicn": float(min_sicn.min()),
-                "mean_sicn": float(min_sicn.mean()),
-                "elements_sicn_below_0.1": int((min_sicn < 0.1).sum()),
+                **written_mesh(tet10_qualities(), msh_out),
                 "surface_patches": len(surfaces),
                 "size_field_tetrahedra": size_field_tets,
                 "algorithm_3d": "delaunay",
@@ -582,18 +583,9 @@ def gmsh_surface_kept(stl: pathlib.Path, size_mm: float, msh_out: pathlib.Path,
         t1 = time.perf_counter()
         gmsh.model.mesh.generate(3)
         t2 = time.perf_counter()
-        tags10, min_sj, min_sicn = tet10_qualities()
-        node_tags, _, _ = gmsh.model.mesh.getNodes()
         boundary = sum(len(t) for t in gmsh.model.mesh.getElements(2)[1])
-        gmsh.write(str(msh_out))
         return {
-            "elements": int(tags10.size),
-            "gmsh_nodes": int(len(node_tags)),
-            "min_scaled_jacobian": float(min_sj.min()),
-            "mean_scaled_jacobian": float(min_sj.mean()),
-            "min_sicn": float(min_sicn.min()),
-            "mean_sicn": float(min_sicn.mean()),
-            "elements_sicn_below_0.1": int((min_sicn < 0.1).sum()),
+            **written_mesh(tet10_qualities(), msh_out),
             "surface_patches": 0,
             "size_field_tetrahedra": size_field_tets,
             "algorithm_3d": "delaunay",
