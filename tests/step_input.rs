@@ -250,8 +250,9 @@ fn step_rods_against_opencascade_and_their_pins() {
 }
 
 /// A folder of real rods with no sidecars (a capless big end as STEP and as coarse STL, a rod
-/// and its cap as two solids, a rod in inches (STEP declares the inch), bores along y): every rod
-/// ranked by `rodstudy study`, the capless one with its open arc said in the record.
+/// and its cap as two solids, a rod in inches (STEP declares the inch), bores along y, R1 fillets
+/// on the bore rims in a coarse STL, whose first fillet faces pass the bore's radius test): every
+/// rod ranked by `rodstudy study`, the capless one with its open arc said in the record.
 #[test]
 fn foreign_rods_through_the_study() {
     let dir = tempfile::tempdir().unwrap();
@@ -266,6 +267,7 @@ fn foreign_rods_through_the_study() {
         "rod_and_cap.step",
         "inches.step",
         "fillets.step",
+        "fillets_coarse.stl",
     ] {
         std::fs::copy(all.join(f), designs.join(f)).unwrap();
     }
@@ -292,7 +294,7 @@ fn foreign_rods_through_the_study() {
         "{results:#}"
     );
     let designs = results["designs"].as_array().unwrap();
-    assert_eq!(designs.len(), 5);
+    assert_eq!(designs.len(), 6);
     for d in designs {
         let id = d["mass"]["id"].as_str().unwrap();
         assert!(
@@ -331,6 +333,7 @@ fn foreign_rods_through_the_study() {
         "rod_and_cap",
         "inches",
         "fillets",
+        "fillets_coarse",
     ] {
         assert!(
             ranking.contains(&format!("| {id} |")),

@@ -12,6 +12,9 @@
 //! chords, inside the cylinder), and all six nodes of a selected face belong to the set.
 //! The set must be plausible: its area close to 2π r × its axial length (`min_coverage`) and no
 //! angular gap above 90° around the axis; an empty or implausible set is an error naming the bore.
+//! The axial length is the set's whole extent, or, where a filleted or chamfered rim lets some
+//! faces of the transition ring pass the radius test (stretching the extent in a few places), the
+//! length that holds the middle 80 % of the area, scaled to the whole.
 
 use serde::{Deserialize, Serialize};
 
@@ -130,6 +133,48 @@ pub struct BoreSurface {
     pub max_angular_gap_deg: f64,
 }
 
+/// The share of a bore set's area left out at each end for [`quantile_length`].
+const LENGTH_QUANTILE: f64 = 0.1;
+
+/// Area of a triangle up to the axial coordinate `z`: its corners' axial coordinates `zs`
+/// (sorted), its area `a`. The area density along the axis rises linearly from zs[0] to zs[1]
+/// and falls linearly to zs[2].
+fn area_below(a: f64, zs: [f64; 3], z: f64) -> f64 {
+    let [z1, z2, z3] = zs;
+    if z <= z1 {
+        0.0
+    } else if z >= z3 || z3 - z1 <= 0.0 {
+        a
+    } else if z <= z2 {
+        a * (z - z1).powi(2) / ((z3 - z1) * (z2 - z1))
+    } else {
+        a * (1.0 - (z3 - z).powi(2) / ((z3 - z1) * (z3 - z2)))
+    }
+}
+
+/// The wall's axial length from the distribution of its area along the axis: the distance
+/// between the axial coordinates below which [`LENGTH_QUANTILE`] and 1 − [`LENGTH_QUANTILE`] of
+/// the area lie, divided by 1 − 2·[`LENGTH_QUANTILE`] (exact for a wall of uniform width). A
+/// sparse fringe of faces at the ends (the first faces of a rim fillet or chamfer that pass the
+/// radius test) moves it little, while it stretches the set's whole extent.
+fn quantile_length(spans: &[(f64, [f64; 3])], zmin: f64, zmax: f64) -> f64 {
+    let total: f64 = spans.iter().map(|s| s.0).sum();
+    let at = |share: f64| -> f64 {
+        let (mut lo, mut hi) = (zmin, zmax);
+        for _ in 0..100 {
+            let mid = 0.5 * (lo + hi);
+            let below: f64 = spans.iter().map(|&(a, zs)| area_below(a, zs, mid)).sum();
+            if below < share * total {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        0.5 * (lo + hi)
+    };
+    (at(1.0 - LENGTH_QUANTILE) - at(LENGTH_QUANTILE)) / (1.0 - 2.0 * LENGTH_QUANTILE)
+}
+
 /// Finds one bore wall, see the module documentation.
 pub fn find_bore(
     mesh: &TetMesh,
@@ -204,10 +249,6 @@ pub fn find_bore(
     let mut nodes: Vec<usize> = faces.iter().flatten().copied().collect();
     nodes.sort_unstable();
     nodes.dedup();
-    let area_m2: f64 = faces
-        .iter()
-        .map(|f| face_area(&face_coords(mesh, f), &TRI6))
-        .sum();
     // axial range and angular coverage from the corners
     let e1 = {
         let t = if axis[0].abs() < 0.9 {
@@ -222,14 +263,23 @@ pub fn find_bore(
     let e2 = super::boundary::cross(axis, e1);
     let (mut zmin, mut zmax) = (f64::INFINITY, f64::NEG_INFINITY);
     let mut angles = Vec::with_capacity(3 * faces.len());
+    // each face's area along the axis (its three corners' axial coordinates), for the length
+    // of the wall between the area's quantiles
+    let mut spans: Vec<(f64, [f64; 3])> = Vec::with_capacity(faces.len());
     for f in &faces {
-        for &n in &f[..3] {
+        let mut z = [0.0; 3];
+        for (k, &n) in f[..3].iter().enumerate() {
             let (rv, along) = radial(mesh.nodes()[n]);
             zmin = zmin.min(along);
             zmax = zmax.max(along);
+            z[k] = along;
             angles.push(dot(rv, e2).atan2(dot(rv, e1)).to_degrees());
         }
+        z.sort_by(|a, b| a.total_cmp(b));
+        spans.push((face_area(&face_coords(mesh, f), &TRI6), z));
     }
+    let area_m2: f64 = spans.iter().map(|s| s.0).sum();
+    let core_length = quantile_length(&spans, zmin, zmax);
     angles.sort_by(|a, b| a.total_cmp(b));
     let mut gap = 360.0 + angles[0] - angles[angles.len() - 1];
     for w in angles.windows(2) {
@@ -244,8 +294,11 @@ pub fn find_bore(
     }
     .clamp(1.0, 360.0);
     let share = arc / 360.0;
-    let plausible =
-        length > 0.0 && coverage >= spec.min_coverage * share && coverage <= 1.05 * share;
+    let core_coverage = area_m2 / (2.0 * std::f64::consts::PI * r_bore * core_length);
+    let within = |c: f64| c >= spec.min_coverage * share && c <= 1.05 * share;
+    // a filleted or chamfered rim: some faces of the transition ring pass the radius test and
+    // stretch the axial range; the length between the area's quantiles is then the wall's
+    let plausible = length > 0.0 && (within(coverage) || within(core_coverage));
     if !plausible {
         let what = if arc < 360.0 {
             format!("an arc of {arc:.0}° of a cylinder wall (the partial bore stage 1 measured)")
@@ -254,12 +307,15 @@ pub fn find_bore(
         };
         return Err(implausible(format!(
             "{} faces at radius {:.3} mm cover {:.1} mm² over an axial length of {:.3} mm: {:.1} % of a \
-             full cylinder wall (expected {:.0}–{:.0} % for {what}); is the pin centre right (rod frame, mm)?",
+             full cylinder wall ({:.1} % over the length {:.3} mm that holds the middle 80 % of the area; expected \
+             {:.0}–{:.0} % for {what}); is the pin centre right (rod frame, mm)?",
             faces.len(),
             r_bore * 1e3,
             area_m2 * 1e6,
             length * 1e3,
             100.0 * coverage,
+            100.0 * core_coverage,
+            core_length * 1e3,
             100.0 * spec.min_coverage * share,
             105.0 * share
         )));
@@ -304,4 +360,49 @@ pub fn find_bores(
         });
     }
     Ok((loaded, fixed))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A triangle with one corner at z = 1 above an edge at z = 0: the part above z = ½ is a
+    /// similar triangle of half the size, a quarter of the area.
+    #[test]
+    fn area_below_a_plane_of_a_triangle() {
+        assert_eq!(area_below(2.0, [0.0, 0.0, 1.0], 0.5), 1.5);
+        // the mirror: an edge at z = 1, a corner at z = 0
+        assert_eq!(area_below(2.0, [0.0, 1.0, 1.0], 0.5), 0.5);
+        // a corner in between: the two pieces meet at zs[1] and add up to the whole
+        let (a, zs) = (3.0, [0.0, 0.25, 1.0]);
+        assert!((area_below(a, zs, 0.25) - a * 0.25).abs() < 1e-15);
+        assert_eq!(area_below(a, zs, -1.0), 0.0);
+        assert_eq!(area_below(a, zs, 2.0), a);
+    }
+
+    /// A wall of uniform width (a strip of triangle pairs) has the length between its area
+    /// quantiles equal to its extent; a sparse fringe of faces beyond one end (the first faces
+    /// of a rim fillet that pass the radius test) stretches the extent by 3 mm but the quantile
+    /// length by under 2 %.
+    #[test]
+    fn quantile_length_of_a_wall_and_of_a_wall_with_a_fringe() {
+        let (length, rows) = (0.028, 14);
+        let dz = length / rows as f64;
+        let mut spans: Vec<(f64, [f64; 3])> = Vec::new();
+        for k in 0..rows {
+            let (z0, z1) = (k as f64 * dz, (k + 1) as f64 * dz);
+            for _ in 0..40 {
+                spans.push((1e-6, [z0, z0, z1]));
+                spans.push((1e-6, [z0, z1, z1]));
+            }
+        }
+        let l = quantile_length(&spans, 0.0, length);
+        assert!((l / length - 1.0).abs() < 1e-12, "{l}");
+        // a fringe: 6 faces of the 80 in a ring reaching 3 mm beyond the end
+        for _ in 0..6 {
+            spans.push((1e-6, [length, length, length + 0.003]));
+        }
+        let l = quantile_length(&spans, 0.0, length + 0.003);
+        assert!((l / length - 1.0).abs() < 0.02, "{l}");
+    }
 }

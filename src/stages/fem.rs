@@ -64,6 +64,8 @@ pub struct AdaptiveMeshing {
     pub initial_size_mm: f64,
     pub max_size_mm: f64,
     pub min_size_mm: f64,
+    /// The smallest size on a STEP's exact geometry, mm.
+    pub step_min_size_mm: f64,
     pub max_iterations: usize,
     pub max_dofs: usize,
 }
@@ -76,6 +78,7 @@ impl AdaptiveMeshing {
             initial_size_mm: c.initial_size_mm,
             max_size_mm: c.max_size_mm,
             min_size_mm: c.min_size_mm,
+            step_min_size_mm: c.step_min_size_mm,
             max_iterations: c.max_iterations,
             max_dofs: c.max_dofs,
         }
@@ -506,11 +509,16 @@ pub fn fem_adaptive(
         }
     };
     let c = settings;
+    let min_size_mm = if exact {
+        c.step_min_size_mm
+    } else {
+        c.min_size_mm
+    };
     let opts = AdaptOptions {
         target_error_rel: c.target_error,
         initial_size_m: c.initial_size_mm * 1e-3,
         max_size_m: c.max_size_mm * 1e-3,
-        min_size_m: c.min_size_mm * 1e-3,
+        min_size_m: min_size_mm * 1e-3,
         max_iterations: c.max_iterations,
         max_dofs: c.max_dofs,
         ..AdaptOptions::default()
@@ -543,9 +551,9 @@ pub fn fem_adaptive(
             stop: out.stop,
             iterations,
             initial_size_mm: c.initial_size_mm,
-            min_size_mm: c.min_size_mm,
+            min_size_mm,
             floor: if exact {
-                "none: the exact geometry (STEP); at least min_size_mm".into()
+                "none: the exact geometry (STEP); at least step_min_size_mm".into()
             } else {
                 format!(
                     "the STL's local facet spacing: the spacing of the nearest kink (below {FEATURE_ANGLE_DEG}°, or a kink of a faceted small fillet), at least min_size_mm"
