@@ -4,8 +4,9 @@
 //! rod frame, the analysis (assembly, symbolic analysis, factorisation, solves, stresses with
 //! recovery and error estimate), the VTU files and the pictures. Each phase is the median of
 //! `repeats` runs; the ratios are against the native read plus the analysis (`fem.total_s`), the
-//! part no output can avoid. Then the whole command, in child processes as a user runs it, with
-//! and without pictures, and optionally CalculiX on the same mesh (`pipeline/ccx_peer.py`).
+//! part no output can avoid. Then the whole command, in child processes as a user runs it, as it
+//! is (pictures, buckling), without pictures, and without pictures and buckling, and optionally
+//! CalculiX on the same mesh (`pipeline/ccx_peer.py`: both static cases, and `*BUCKLE`).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -53,8 +54,15 @@ pub struct WholeRun {
     pub fem_total_s: f64,
     /// Its `mesh.seconds` (reading and moving the mesh), s.
     pub mesh_s: f64,
+    /// Its `buckling_s` (the buckling analysis on the factorised K), s; `None` with
+    /// `--no-buckling`.
+    pub buckling_s: Option<f64>,
     /// wall / fem.total_s.
     pub ratio_to_fem_total: f64,
+    /// wall / (fem.total_s + buckling_s): the whole command against all the analysis it made.
+    pub ratio_to_analysis: f64,
+    /// Its `buckling_load_factor`.
+    pub buckling_load_factor: Option<f64>,
 }
 
 /// CalculiX on the same mesh (`pipeline/ccx_peer.py --json`).
@@ -62,11 +70,18 @@ pub struct WholeRun {
 pub struct CcxRun {
     /// ccx's wall time for both load cases (deck writing and .frd reading excluded), s.
     pub ccx_wall_s: f64,
+    /// ccx's wall time for `*BUCKLE` under the F_x load on the same mesh (its own static
+    /// pre-stress solve included), s.
+    pub ccx_buckle_wall_s: f64,
+    /// ccx's buckling factor and ours on the same mesh (the run with buckling).
+    pub buckling_factor: f64,
+    pub ours_buckling_factor: Option<f64>,
     /// ccx's nodally averaged von Mises maxima, F_x and F_y, MPa.
     pub max_von_mises_averaged_mpa: [f64; 2],
     /// Ours on the same mesh (the run above), MPa.
     pub ours_max_von_mises_averaged_mpa: [f64; 2],
-    /// Each whole `fem --mesh` run of [`MeshPathBench::runs`] / ccx's wall time.
+    /// Each whole `fem --mesh` run of [`MeshPathBench::runs`] / ccx's wall time for the same
+    /// work: both static cases, plus `*BUCKLE` for a run that computes buckling.
     pub ratio_fem_runs_to_ccx: Vec<f64>,
 }
 
@@ -293,11 +308,14 @@ pub fn bench_fem_mesh(
         mesh_file,
         force_n,
         repeats,
-        &[vec![], vec!["--no-pictures".to_string()]],
+        &[
+            vec![],
+            vec!["--no-pictures".to_string()],
+            vec!["--no-buckling".to_string(), "--no-pictures".to_string()],
+        ],
     )?;
     let ccx = if ccx {
-        let walls: Vec<f64> = runs.iter().map(|r| r.wall_s).collect();
-        Some(ccx_run(&mesh, force_n, work.path(), r, &walls)?)
+        Some(ccx_run(&mesh, force_n, work.path(), r, &runs)?)
     } else {
         None
     };
@@ -355,7 +373,8 @@ fn whole_runs(
             let v: serde_json::Value = serde_json::from_slice(&o.stdout)?;
             let total = v["fem"]["total_s"].as_f64().unwrap_or(f64::NAN);
             let mesh_s = v["mesh"]["seconds"].as_f64().unwrap_or(f64::NAN);
-            rows.push((wall, total, mesh_s));
+            let buckling = (v["buckling_s"].as_f64(), v["buckling_load_factor"].as_f64());
+            rows.push((wall, total, mesh_s, buckling));
         }
     }
     Ok(variants
@@ -363,13 +382,16 @@ fn whole_runs(
         .zip(rows)
         .map(|(extra, mut rows)| {
             rows.sort_by(|a, b| a.0.total_cmp(&b.0));
-            let (wall_s, fem_total_s, mesh_s) = rows[rows.len() / 2];
+            let (wall_s, fem_total_s, mesh_s, (buckling_s, load_factor)) = rows[rows.len() / 2];
             WholeRun {
                 extra_args: extra.clone(),
                 wall_s,
                 fem_total_s,
                 mesh_s,
+                buckling_s,
+                buckling_load_factor: load_factor,
                 ratio_to_fem_total: wall_s / fem_total_s,
+                ratio_to_analysis: wall_s / (fem_total_s + buckling_s.unwrap_or(0.0)),
             }
         })
         .collect())
@@ -381,27 +403,33 @@ fn ccx_run(
     force_n: f64,
     work: &Path,
     ours: &crate::fem::FemResult,
-    fem_runs_wall_s: &[f64],
+    runs: &[WholeRun],
 ) -> Result<CcxRun> {
     let rodmesh = work.join("rod_frame.rodmesh");
     crate::mesher::write_rodmesh(mesh, &rodmesh)?;
     let python = crate::python_env::python()?;
-    let o = Command::new(&python)
-        .arg(crate::python_env::pipeline_script("ccx_peer.py"))
-        .arg(&rodmesh)
-        .args(["--force", &force_n.to_string(), "--json"])
-        .output()?;
-    if !o.status.success() {
-        bail!("ccx_peer.py: {}", String::from_utf8_lossy(&o.stderr).trim());
-    }
-    let text = String::from_utf8_lossy(&o.stdout);
-    let line = text
-        .lines()
-        .rev()
-        .find(|l| l.starts_with('{'))
-        .context("ccx_peer.py printed no JSON")?;
-    let v: serde_json::Value = serde_json::from_str(line)?;
+    let peer = |extra: &[&str]| -> Result<serde_json::Value> {
+        let o = Command::new(&python)
+            .arg(crate::python_env::pipeline_script("ccx_peer.py"))
+            .arg(&rodmesh)
+            .args(["--force", &force_n.to_string(), "--json"])
+            .args(extra)
+            .output()?;
+        if !o.status.success() {
+            bail!("ccx_peer.py: {}", String::from_utf8_lossy(&o.stderr).trim());
+        }
+        let text = String::from_utf8_lossy(&o.stdout);
+        let line = text
+            .lines()
+            .rev()
+            .find(|l| l.starts_with('{'))
+            .context("ccx_peer.py printed no JSON")?;
+        Ok(serde_json::from_str(line)?)
+    };
+    let v = peer(&[])?;
     let ccx_wall_s = v["ccx_wall_s"].as_f64().context("ccx_wall_s")?;
+    let b = peer(&["--buckle"])?;
+    let ccx_buckle_wall_s = b["ccx_wall_s"].as_f64().context("ccx_wall_s")?;
     let vm = |c: &str| {
         v[c]["max_von_mises_averaged_mpa"]
             .as_f64()
@@ -409,12 +437,25 @@ fn ccx_run(
     };
     Ok(CcxRun {
         ccx_wall_s,
+        ccx_buckle_wall_s,
+        buckling_factor: b["buckling_factor"].as_f64().unwrap_or(f64::NAN),
+        ours_buckling_factor: runs.iter().find_map(|r| r.buckling_load_factor),
         max_von_mises_averaged_mpa: [vm("fx"), vm("fy")],
         ours_max_von_mises_averaged_mpa: [
             ours.fx.max_von_mises_averaged_mpa,
             ours.fy.max_von_mises_averaged_mpa,
         ],
-        ratio_fem_runs_to_ccx: fem_runs_wall_s.iter().map(|w| w / ccx_wall_s).collect(),
+        ratio_fem_runs_to_ccx: runs
+            .iter()
+            .map(|r| {
+                let peer = if r.buckling_s.is_some() {
+                    ccx_wall_s + ccx_buckle_wall_s
+                } else {
+                    ccx_wall_s
+                };
+                r.wall_s / peer
+            })
+            .collect(),
     })
 }
 
@@ -462,20 +503,22 @@ pub fn markdown(b: &MeshPathBench) -> String {
     );
     let _ = writeln!(
         s,
-        "\n| `fem --mesh` command | wall [s] | fem.total_s [s] | mesh.seconds [s] | wall / fem.total_s |\n|---|---|---|---|---|"
+        "\n| `fem --mesh` command | wall [s] | fem.total_s [s] | buckling_s [s] | mesh.seconds [s] | wall / fem.total_s | wall / (fem.total_s + buckling_s) |\n|---|---|---|---|---|---|---|"
     );
     for r in &b.runs {
         let _ = writeln!(
             s,
-            "| `--json{}` | {:.2} | {:.2} | {:.3} | {:.2} |",
+            "| `--json{}` | {:.2} | {:.2} | {} | {:.3} | {:.2} | {:.2} |",
             r.extra_args
                 .iter()
                 .map(|a| format!(" {a}"))
                 .collect::<String>(),
             r.wall_s,
             r.fem_total_s,
+            r.buckling_s.map_or("—".into(), |b| format!("{b:.2}")),
             r.mesh_s,
-            r.ratio_to_fem_total
+            r.ratio_to_fem_total,
+            r.ratio_to_analysis
         );
     }
     if let Some(c) = &b.ccx {
@@ -495,8 +538,12 @@ pub fn markdown(b: &MeshPathBench) -> String {
             .collect();
         let _ = writeln!(
             s,
-            "\nCalculiX on the same mesh (`pipeline/ccx_peer.py`, both cases, SPOOLES): {:.2} s; `fem --mesh` / ccx: {}; averaged von Mises F_x {:.4} / {:.4} MPa, F_y {:.4} / {:.4} MPa (ccx / ours)",
+            "\nCalculiX on the same mesh (`pipeline/ccx_peer.py`, SPOOLES): both static cases {:.2} s, `*BUCKLE` under F_x {:.2} s (factor {:.4} / ours {}); `fem --mesh` / ccx doing the same work (static, plus `*BUCKLE` for a run with buckling): {}; averaged von Mises F_x {:.4} / {:.4} MPa, F_y {:.4} / {:.4} MPa (ccx / ours)",
             c.ccx_wall_s,
+            c.ccx_buckle_wall_s,
+            c.buckling_factor,
+            c.ours_buckling_factor
+                .map_or("—".into(), |f| format!("{f:.4}")),
             ratios.join(", "),
             c.max_von_mises_averaged_mpa[0],
             c.ours_max_von_mises_averaged_mpa[0],

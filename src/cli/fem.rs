@@ -34,6 +34,10 @@ pub struct FemArgs {
     /// Write the VTU files only, not the von Mises pictures (von_mises_fx.svg, _fy.svg).
     #[arg(long)]
     no_pictures: bool,
+    /// Leave out the linear buckling analysis (computed by default: `buckling_load_factor`),
+    /// e.g. to time the static analysis alone against another solver's.
+    #[arg(long)]
+    no_buckling: bool,
     /// Refinement study over these element sizes [mm] instead of one analysis, e.g. 8,5,3.5.
     #[arg(long, value_delimiter = ',')]
     refine: Option<Vec<f64>>,
@@ -108,11 +112,14 @@ pub fn run(args: FemArgs) -> Result<i32> {
         return Ok(0);
     }
     // the factorised K of the final mesh is kept for the buckling case (the same supports)
+    let keep = !args.no_buckling;
     let mut outcome =
-        stages::fem::fem_keeping(&design, force, &config, &args.out.join("mesh"), &mode, true)?;
-    // buckling, always: under --force if given, else the peak compression (with a pressure
+        stages::fem::fem_keeping(&design, force, &config, &args.out.join("mesh"), &mode, keep)?;
+    // buckling unless --no-buckling: under --force if given, else the peak compression (with a pressure
     // trace, where stage 3 has computed and judged it already) or the peak pin force (F_x)
-    if outcome.record.buckling_load_factor.is_none() || args.force.is_some() {
+    let mut buckling_cost: Option<(f64, usize)> = None;
+    if !args.no_buckling && (outcome.record.buckling_load_factor.is_none() || args.force.is_some())
+    {
         let load = match args.force {
             Some(f) => f,
             None => stages::fem::buckling_load(&design, &config)?,
@@ -124,6 +131,7 @@ pub fn run(args: FemArgs) -> Result<i32> {
             outcome.solution.system.as_deref(),
         ) {
             Ok(b) => {
+                buckling_cost = Some((b.static_s + b.geometric_s + b.iteration_s, b.iterations));
                 outcome.record.buckling_load_factor = Some(b.load_factor);
                 outcome.solution.buckling = Some(crate::fem::buckling::BucklingMode {
                     load_factor: b.load_factor,
@@ -161,6 +169,8 @@ pub fn run(args: FemArgs) -> Result<i32> {
     if args.json {
         let mut json = FemJson::from(&result);
         json.buckling_load_n = buckling_load_n;
+        json.buckling_s = buckling_cost.map(|c| c.0);
+        json.buckling_iterations = buckling_cost.map(|c| c.1);
         println!("{}", serde_json::to_string_pretty(&json)?);
     } else {
         print_result(&result);
@@ -193,6 +203,11 @@ struct FemJson<'a> {
     /// The compression λ₁ refers to: `--force`, else the peak compression with a pressure
     /// trace, else the peak pin force [N].
     buckling_load_n: Option<f64>,
+    /// Wall time of the buckling analysis on stage 3's factorised K (the pre-stress solve, K_σ,
+    /// the subspace iteration), s; not part of `fem.total_s`. `null` when not computed.
+    buckling_s: Option<f64>,
+    /// Subspace iterations the buckling analysis made.
+    buckling_iterations: Option<usize>,
     /// Peak resident memory of this process so far (VmHWM) [MB].
     peak_memory_mb: Option<f64>,
 }
@@ -211,6 +226,8 @@ impl<'a> From<&'a DesignFem> for FemJson<'a> {
             fem: &d.fem,
             buckling_load_factor: d.buckling_load_factor,
             buckling_load_n: None,
+            buckling_s: None,
+            buckling_iterations: None,
             peak_memory_mb: crate::bench::fem_rod::peak_memory_mb(),
         }
     }

@@ -14,7 +14,9 @@
 //! shift, so that the one Cholesky factor of K — the one the static solve already used — serves
 //! every iteration): a block X of p vectors,
 //!
-//! 1. Y = −K_σ X, X̄ = K⁻¹ Y (one multi-right-hand-side solve with the factor of K);
+//! 1. Y = −K_σ X, X̄ = K⁻¹ Y (one multi-right-hand-side solve with the factor of K; after the
+//!    first iteration Y is carried over as (−K_σ X̄) Z from step 3, Bathe §11.6.3, so that each
+//!    iteration multiplies by K_σ once);
 //! 2. the projections K_r = X̄ᵀ K X̄ = X̄ᵀ Y and G_r = X̄ᵀ (−K_σ) X̄;
 //! 3. the small dense problem G_r z = μ K_r z (K_r = L Lᵀ, the symmetric eigenproblem of
 //!    L⁻¹ G_r L⁻ᵀ, nalgebra), X ← X̄ Z, K-orthonormal;
@@ -312,9 +314,11 @@ fn buckling_on(
     let mut iterations = 0;
     let mut converged = false;
     let mut largest_previous = f64::NAN;
+    // Y = G X; after the first iteration carried over as (G X̄) Q (Bathe §11.6.3), so that each
+    // iteration multiplies by G once
+    let mut y = mul_block(&g, &x, p);
     for it in 1..=options.max_iterations {
         iterations = it;
-        let y = mul_block(&g, &x, p);
         let mut xb = y.clone();
         factor.solve_in_place(&mut xb, p);
         let kr = gram(&xb, &y, n, p);
@@ -341,19 +345,24 @@ fn buckling_on(
         let mut order: Vec<usize> = (0..p).collect();
         order.sort_by(|&i, &j| eig.eigenvalues[j].total_cmp(&eig.eigenvalues[i]));
         let z = linv.transpose() * &eig.eigenvectors;
-        let mut xn = vec![0.0; n * p];
-        for (k, &col) in order.iter().enumerate() {
-            let out = &mut xn[k * n..(k + 1) * n];
-            for m in 0..p {
-                let w = z[(m, col)];
-                if w != 0.0 {
-                    for (o, v) in out.iter_mut().zip(&xb[m * n..(m + 1) * n]) {
-                        *o += w * v;
+        // X = X̄ Q and Y = (G X̄) Q, Q the Ritz vectors in descending μ
+        let combine = |block: &[f64]| -> Vec<f64> {
+            let mut out = vec![0.0; n * p];
+            for (k, &col) in order.iter().enumerate() {
+                let o = &mut out[k * n..(k + 1) * n];
+                for m in 0..p {
+                    let w = z[(m, col)];
+                    if w != 0.0 {
+                        for (o, v) in o.iter_mut().zip(&block[m * n..(m + 1) * n]) {
+                            *o += w * v;
+                        }
                     }
                 }
             }
-        }
-        x = xn;
+            out
+        };
+        x = combine(&xb);
+        y = combine(&gx);
         let mus: Vec<f64> = order.iter().map(|&i| eig.eigenvalues[i]).collect();
         let scale = mus.iter().fold(0.0f64, |a, m| a.max(m.abs()));
         ritz = mus.iter().map(|m| 1.0 / m).collect();

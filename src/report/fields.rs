@@ -28,8 +28,7 @@ pub fn write_fem_fields(
     dir: &Path,
     stem: &str,
 ) -> Result<()> {
-    write_fem_vtus(result, solution, mesh, dir, stem)?;
-    write_fem_pictures(result, solution, mesh, dir)
+    write_fem_files(result, solution, mesh, dir, stem, FemFiles::VtuAndPictures)
 }
 
 /// Writes the buckling mode φ₁ (largest component 1, dimensionless; a point field `mode` and
@@ -74,8 +73,8 @@ pub fn write_buckling_mode(dir: &Path, mesh: &TetMesh, mode: &BucklingMode) -> R
     Ok(path)
 }
 
-/// The ParaView files of [`write_fem_fields`] alone (`<dir>/<stem>_fx.vtu`, `_fy.vtu`, and
-/// `buckling_mode.vtu` when the solution carries a buckling mode).
+/// The ParaView files of [`write_fem_fields`] alone (`<stem>_fx.vtu`, `_fy.vtu`, and
+/// `buckling_mode.vtu` when the solution has a mode), no pictures.
 pub fn write_fem_vtus(
     result: &mut FemResult,
     solution: &RodSolution,
@@ -83,30 +82,7 @@ pub fn write_fem_vtus(
     dir: &Path,
     stem: &str,
 ) -> Result<()> {
-    std::fs::create_dir_all(dir).map_err(|e| FemError::io(dir, e))?;
-    for c in 0..2 {
-        let case = if c == 0 {
-            &mut result.fx
-        } else {
-            &mut result.fy
-        };
-        let path = dir.join(format!("{stem}_{}.vtu", case.name));
-        write_case_vtu(
-            &path,
-            mesh,
-            &solution.displacements[c],
-            &solution.stresses[c],
-            &solution.estimates[c],
-            &solution.fixed,
-            &solution.loaded,
-            &solution.away_from_fixed,
-        )?;
-        case.vtu = Some(path);
-    }
-    if let Some(mode) = &solution.buckling {
-        write_buckling_mode(dir, mesh, mode)?;
-    }
-    Ok(())
+    write_fem_files(result, solution, mesh, dir, stem, FemFiles::Vtu)
 }
 
 /// The pictures of [`write_fem_fields`] alone (`<dir>/von_mises_fx.svg`, `_fy.svg`).
@@ -116,16 +92,74 @@ pub fn write_fem_pictures(
     mesh: &TetMesh,
     dir: &Path,
 ) -> Result<()> {
+    write_fem_files(result, solution, mesh, dir, "", FemFiles::Pictures)
+}
+
+/// Which of stage 3's files [`write_fem_files`] writes.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum FemFiles {
+    Vtu,
+    Pictures,
+    VtuAndPictures,
+}
+
+/// Stage 3's files: each written by its own task, the tasks in parallel (they share nothing but
+/// the read-only solution), so that the whole costs about its longest file on two cores.
+fn write_fem_files(
+    result: &mut FemResult,
+    solution: &RodSolution,
+    mesh: &TetMesh,
+    dir: &Path,
+    stem: &str,
+    which: FemFiles,
+) -> Result<()> {
+    use rayon::prelude::*;
     std::fs::create_dir_all(dir).map_err(|e| FemError::io(dir, e))?;
+    let vtus = which != FemFiles::Pictures;
+    let pictures = which != FemFiles::Vtu;
+    let cases = [&result.fx, &result.fy];
+    let vtu_paths = cases.map(|c| dir.join(format!("{stem}_{}.vtu", c.name)));
+    let picture_paths = cases.map(|c| dir.join(format!("von_mises_{}.svg", c.name)));
+    type Task<'a> = Box<dyn FnOnce() -> Result<()> + Send + 'a>;
+    let mut tasks: Vec<Task> = Vec::new();
     for c in 0..2 {
-        let case = if c == 0 {
-            &mut result.fx
-        } else {
-            &mut result.fy
-        };
-        let picture = dir.join(format!("von_mises_{}.svg", case.name));
-        write_case_picture(&picture, mesh, &solution.stresses[c], case)?;
-        case.picture = Some(picture);
+        if vtus {
+            let path = &vtu_paths[c];
+            tasks.push(Box::new(move || {
+                write_case_vtu(
+                    path,
+                    mesh,
+                    &solution.displacements[c],
+                    &solution.stresses[c],
+                    &solution.estimates[c],
+                    &solution.fixed,
+                    &solution.loaded,
+                    &solution.away_from_fixed,
+                )
+            }));
+        }
+        if pictures {
+            let (path, case) = (&picture_paths[c], cases[c]);
+            tasks.push(Box::new(move || {
+                write_case_picture(path, mesh, &solution.stresses[c], case)
+            }));
+        }
+    }
+    if let (true, Some(mode)) = (vtus, &solution.buckling) {
+        tasks.push(Box::new(move || {
+            write_buckling_mode(dir, mesh, mode).map(|_| ())
+        }));
+    }
+    tasks.into_par_iter().map(|t| t()).collect::<Result<()>>()?;
+    let [vfx, vfy] = vtu_paths;
+    let [pfx, pfy] = picture_paths;
+    if vtus {
+        result.fx.vtu = Some(vfx);
+        result.fy.vtu = Some(vfy);
+    }
+    if pictures {
+        result.fx.picture = Some(pfx);
+        result.fy.picture = Some(pfy);
     }
     Ok(())
 }

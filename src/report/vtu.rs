@@ -35,9 +35,14 @@ fn data_array(s: &mut String, f: &VtuField, expected: usize) -> Result<()> {
         r#"<DataArray type="Float64" Name="{}" NumberOfComponents="{}" format="ascii">"#,
         f.name, f.components
     );
+    // written in place (no string per value): the same bytes as joining `{v:e}` with spaces
     for row in f.data.chunks(f.components) {
-        let line: Vec<String> = row.iter().map(|v| format!("{v:e}")).collect();
-        s.push_str(&line.join(" "));
+        for (k, v) in row.iter().enumerate() {
+            if k > 0 {
+                s.push(' ');
+            }
+            let _ = write!(s, "{v:e}");
+        }
         s.push('\n');
     }
     s.push_str("</DataArray>\n");
@@ -86,8 +91,12 @@ pub fn write_vtu(
         "</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n",
     );
     for el in mesh.elements() {
-        let line: Vec<String> = el.iter().map(|n| n.to_string()).collect();
-        s.push_str(&line.join(" "));
+        for (k, n) in el.iter().enumerate() {
+            if k > 0 {
+                s.push(' ');
+            }
+            let _ = write!(s, "{n}");
+        }
         s.push('\n');
     }
     s.push_str("</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n");
