@@ -31,7 +31,9 @@
 //!    the fully fixed edge is a singularity that refinement would chase for ever, so the band is
 //!    a fixed physical distance, not a number of elements; likewise the bands around sharp
 //!    re-entrant edges (singular, [`super::facets::reentrant_edges`]). Within twice a band of a
-//!    singularity no size goes below a third of the band, so the loop does not chase it. The
+//!    singularity no size goes below a third of the band (a sixth of a sharp edge's: the judged
+//!    peak often sits at that band's border, which a third could not resolve), so the loop does
+//!    not chase it. The
 //!    floor elsewhere is the local facet spacing of the STL ([`super::facets`]), never below
 //!    `min_size_m`. The new mesh's DOFs are
 //!    predicted from the size ratios; above the cap all sizes are scaled up to fit, and the

@@ -294,7 +294,9 @@ pub struct RodSolution {
     /// Nodes outside the bands around the fixed bore and the singular edges (the judged nodes).
     pub away_from_fixed: Vec<bool>,
     /// Per node, the smallest element size adaptive refinement may ask for near a singularity
-    /// (a third of the band within twice the band of it, else 0), m.
+    /// (within twice the band of it: a third of the fixed bore's band, a sixth of a sharp edge's,
+    /// so that six elements lie between the edge and the judged stress at the band's border;
+    /// else 0), m.
     pub singularity_floor_m: Vec<f64>,
     /// Error estimates for fx and fy.
     pub estimates: [ErrorEstimate; 2],
@@ -391,8 +393,8 @@ pub fn solve_rod_fields(
         .map(|(f, e)| match (f, e) {
             (true, true) => 0.0,
             (false, true) => band / 3.0,
-            (true, false) => singular_band / 3.0,
-            (false, false) => (band / 3.0).max(singular_band / 3.0),
+            (true, false) => singular_band / 6.0,
+            (false, false) => (band / 3.0).max(singular_band / 6.0),
         })
         .collect();
     // the nodes left out for a sharp edge alone (not for the fixed bore)
