@@ -10,8 +10,8 @@ use std::sync::OnceLock;
 
 use rodstudy::fem::TetMesh;
 use rodstudy::mesher::{
-    MESH_READER_VAR, VolumeReader, mesh_stl, read_volume_mesh_meshio, read_volume_mesh_native,
-    volume_reader,
+    MESH_READER_VAR, MeshRequest, VolumeReader, mesh_stl, mesh_stl_with, read_rodmesh,
+    read_volume_mesh_meshio, read_volume_mesh_native, volume_reader,
 };
 
 fn python() -> PathBuf {
@@ -119,6 +119,31 @@ fn native_readers_give_the_meshio_mesh_bit_for_bit() {
     let c = read_volume_mesh_native(&dir.join("quadratic.inp"), "mm").unwrap();
     assert_identical(&a, &b, "ascii vs binary");
     assert_identical(&a, &c, "msh vs inp");
+}
+
+/// The adaptive loop's hand-off (`--no-rodmesh`): the mesher writes no `.rodmesh` and the `.msh`
+/// is read natively, giving the mesh of the `.rodmesh` route bit for bit (the same STL and size
+/// mesh the same; reference: the `.rodmesh` meshio wrote in `meshes()`).
+#[test]
+fn the_mesher_hands_over_the_msh_natively_without_a_rodmesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let meshed = mesh_stl_with(
+        &python(),
+        &root().join("pipeline/mesh_rod.py"),
+        &root().join("designs/design1.stl"),
+        &MeshRequest {
+            size_mm: 8.0,
+            native_read: true,
+            ..MeshRequest::default()
+        },
+        dir.path(),
+    )
+    .unwrap();
+    assert_eq!(meshed.report.rodmesh, None);
+    assert!(!dir.path().join("design1.rodmesh").exists());
+    let reference = read_rodmesh(&meshes().join("design1.rodmesh")).unwrap();
+    assert_identical(&meshed.mesh, &reference, "native hand-off");
+    assert_eq!(meshed.report.nodes, reference.n_nodes());
 }
 
 /// A two-element .inp (the corner tetrahedron of a unit cube and its neighbour), elements

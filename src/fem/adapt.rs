@@ -4,7 +4,8 @@
 //! The loop (after the strategy of Zienkiewicz & Zhu, IJNME 24 (1987) and 33 (1992), with the
 //! goal-oriented stopping test of the peak itself):
 //!
-//! 1. mesh (uniform at the initial size, then from a size map), solve both load cases with one
+//! 1. mesh (uniform at the initial size, then from a size map capped at the largest size), solve
+//!    both load cases with one
 //!    factorisation ([`super::rod`]), recover σ* and estimate ([`super::estimate`]);
 //! 2. the peak's estimated error: on the first mesh the single-mesh bound (the largest pointwise
 //!    indicator near the peak, [`super::estimate`]); from the second on, Richardson
@@ -91,7 +92,8 @@ impl Default for AdaptOptions {
 pub struct MeshAsk<'a> {
     /// 0 for the first mesh.
     pub iteration: usize,
-    /// Uniform size of the first mesh, and the cap, m.
+    /// Uniform size of the first mesh; of a mesh from a size map, the cap (the largest size, as
+    /// the map itself is capped), m.
     pub size_m: f64,
     /// The previous mesh and the size wanted at each of its nodes, m.
     pub size_map: Option<(&'a TetMesh, &'a [f64])>,
@@ -288,10 +290,18 @@ pub fn adaptive_rod(
     let mut iteration = 0;
     loop {
         let t_it = Instant::now();
+        // the first mesh is uniform; a later one is capped at the largest size, as its size map
+        // is (capped at the first mesh's size, the low-stress regions could never coarsen, and
+        // every mesh kept the first one's DOFs there: issue 21 item 3)
+        let size_map = next_sizes.as_ref().map(|(m, s)| (m, s.as_slice()));
         let ask = MeshAsk {
             iteration,
-            size_m: opts.initial_size_m,
-            size_map: next_sizes.as_ref().map(|(m, s)| (m, s.as_slice())),
+            size_m: if size_map.is_some() {
+                opts.max_size_m.max(opts.initial_size_m)
+            } else {
+                opts.initial_size_m
+            },
+            size_map,
         };
         let (mesh, secs) = mesher.mesh(&ask)?;
         mesh_s += secs;
@@ -550,6 +560,47 @@ mod tests {
             e3 > exact3 && (q - 2.0).abs() < 1e-9,
             "{e3} vs {exact3}, q {q}"
         );
+    }
+
+    /// The first mesh is asked uniform at the initial size; every later one from a size map,
+    /// capped at the largest size (not at the first mesh's size: the low-stress regions may
+    /// coarsen beyond it, issue 21 item 3), and the map never asks for more.
+    #[test]
+    fn later_meshes_are_capped_at_the_largest_size_not_the_first() {
+        use crate::fem::mesh::structured::{TwoEyePlate, two_eye_plate};
+        let mesh = two_eye_plate(&TwoEyePlate::default()).unwrap();
+        let mut asks: Vec<(f64, Option<f64>)> = Vec::new();
+        let mut mesher = |ask: &MeshAsk<'_>| -> Result<(TetMesh, f64)> {
+            let largest = ask
+                .size_map
+                .map(|(_, s)| s.iter().copied().fold(0.0, f64::max));
+            asks.push((ask.size_m, largest));
+            Ok((mesh.clone(), 0.0))
+        };
+        let opts = AdaptOptions {
+            max_iterations: 3,
+            ..AdaptOptions::default()
+        };
+        adaptive_rod(
+            &mut mesher,
+            &Material::default(),
+            &BoreSpec::default(),
+            7500.0,
+            &RodOptions::default(),
+            &opts,
+            &|_| 0.0,
+        )
+        .unwrap();
+        assert!(asks.len() >= 2, "{asks:?}");
+        assert_eq!(asks[0], (opts.initial_size_m, None));
+        for (cap, largest) in &asks[1..] {
+            assert_eq!(*cap, opts.max_size_m);
+            let largest = largest.expect("a size map");
+            assert!(
+                largest <= opts.max_size_m && largest > opts.initial_size_m,
+                "{largest}"
+            );
+        }
     }
 
     /// A sequence that turns back is not extrapolated: the estimate is the spread of the last

@@ -73,12 +73,25 @@ impl GmshRodMesher {
         self.step.is_some()
     }
 
-    /// One mesh of uniform size `size_mm` (with a size field: its cap) into `dir`.
+    /// One mesh of uniform size `size_mm` (with a size field: its cap) into `dir`, with its
+    /// `.rodmesh` hand-off file.
     pub fn mesh_into(
         &self,
         size_mm: f64,
         size_field: Option<&Path>,
         dir: &Path,
+    ) -> Result<MeshedRod> {
+        self.mesh_into_reading(size_mm, size_field, dir, false)
+    }
+
+    /// [`Self::mesh_into`]; `native_read`: no `.rodmesh`, the `.msh` read natively (the same mesh
+    /// bit for bit, without meshio's conversion).
+    fn mesh_into_reading(
+        &self,
+        size_mm: f64,
+        size_field: Option<&Path>,
+        dir: &Path,
+        native_read: bool,
     ) -> Result<MeshedRod> {
         if let Some(step) = &self.step {
             return mesh_step_with(
@@ -90,6 +103,7 @@ impl GmshRodMesher {
                     size_field,
                     geometry: None,
                     name: Some("rod"),
+                    native_read,
                 },
                 dir,
             );
@@ -103,6 +117,7 @@ impl GmshRodMesher {
                 size_field,
                 geometry: Some(&self.geometry),
                 name: Some("rod"),
+                native_read,
             },
             dir,
         )
@@ -147,7 +162,8 @@ impl Mesher for GmshRodMesher {
                 }
                 None => None,
             };
-            match self.mesh_into(ask.size_m * 1e3 * scale, field, &dir) {
+            // the loop's meshes are read natively: no meshio conversion, no .rodmesh
+            match self.mesh_into_reading(ask.size_m * 1e3 * scale, field, &dir, true) {
                 Ok(m) => break m,
                 Err(e) if tries < 2 => {
                     eprintln!(
