@@ -825,15 +825,8 @@ def gmsh_step_mesh(step: pathlib.Path, frame: list, scale: float, size_mm: float
                                f"high-order optimiser (min scaled Jacobian {min_sj.min():.3g}): not solved on")
         if delaunay is False and min_sicn.min() < MIN_SICN:
             raise RuntimeError(f"HXT left a sliver (min SICN {min_sicn.min():.2e} < {MIN_SICN})")
-        node_tags, _, _ = gmsh.model.mesh.getNodes()
-        gmsh.write(str(msh_out))
         return {
-            "elements": int(tags10.size),
-            "gmsh_nodes": int(len(node_tags)),
-            "min_scaled_jacobian": float(min_sj.min()),
-            "mean_scaled_jacobian": float(min_sj.mean()),
-            "min_sicn": float(min_sicn.min()),
-            "mean_sicn": float(min_sicn.mean()),
+            **written_mesh((tags10, min_sj, min_sicn), msh_out),
             "solids": len(solids),
             "size_field_tetrahedra": size_field_tets,
             "algorithm_3d": "delaunay" if delaunay else "hxt",

@@ -60,6 +60,20 @@ fn fem(dir: &Path, name: &str, config: &StudyConfig, mode: &MeshMode) -> DesignF
         .record
 }
 
+/// Stage 3 of the STL `stl` under `force` [N], refined adaptively to the configuration's target.
+fn adaptive_record(
+    stl: &std::path::Path,
+    force: f64,
+    config: &StudyConfig,
+    work: &std::path::Path,
+) -> rodstudy::stages::records::DesignFem {
+    let design = stages::mass::load(stl).unwrap();
+    let mode = MeshMode::Adaptive(AdaptiveMeshing::new(&config.fem, config.fem.target_error));
+    stages::fem::fem(&design, force, config, work, &mode)
+        .unwrap()
+        .record
+}
+
 #[test]
 fn the_stress_does_not_depend_on_units_or_pose() {
     let dir = tempfile::tempdir().unwrap();
@@ -155,16 +169,7 @@ fn adaptive_peak_reaches_the_converged_reference_of_the_fillet_rod() {
     assert_eq!(config.fem.target_error, 0.03);
     let force = data["force_n"].as_f64().unwrap();
     let work = dir.path().join("work");
-    let design = stages::mass::load(&stl).unwrap();
-    let r = stages::fem::fem(
-        &design,
-        force,
-        &config,
-        &work,
-        &MeshMode::Adaptive(AdaptiveMeshing::new(&config.fem, config.fem.target_error)),
-    )
-    .unwrap()
-    .record;
+    let r = adaptive_record(&stl, force, &config, &work);
     let h: Vec<f64> = data["near_size_mm"]
         .as_array()
         .unwrap()
@@ -316,17 +321,8 @@ fn the_geometry_error_of_a_coarse_cad_export_is_estimated_honestly() {
     fillet_rod(&["step", step.to_str().unwrap()]);
     let config = StudyConfig::default();
     let force = data["force_n"].as_f64().unwrap();
-    let design = stages::mass::load(&stl).unwrap();
     let work = dir.path().join("work");
-    let r = stages::fem::fem(
-        &design,
-        force,
-        &config,
-        &work,
-        &MeshMode::Adaptive(AdaptiveMeshing::new(&config.fem, config.fem.target_error)),
-    )
-    .unwrap()
-    .record;
+    let r = adaptive_record(&stl, force, &config, &work);
     let last = r.mesh.adaptive.as_ref().unwrap().iterations - 1;
     let size = r.fem.fy.adaptive.last().unwrap().size_at_peak_mm;
     assert!(size < 2.5, "F_y: {size} mm elements at the peak");
@@ -339,7 +335,7 @@ fn the_geometry_error_of_a_coarse_cad_export_is_estimated_honestly() {
         exact.to_str().unwrap(),
     ]);
     let on_brep = stages::fem::fem(
-        &design,
+        &stages::mass::load(&stl).unwrap(),
         force,
         &config,
         &dir.path().join("work-exact"),
