@@ -378,3 +378,49 @@ fn fem_with_a_user_mesh_gives_the_same_numbers_either_way() {
         );
     }
 }
+
+/// `fem --mesh … --json` computes the buckling factor by default (with its time and iterations,
+/// and the mode file); `--no-buckling` leaves it out and changes nothing of the static analysis.
+#[test]
+fn fem_no_buckling_leaves_out_buckling_and_nothing_else() {
+    let design = root().join("designs/design1.stl");
+    let run = |extra: &[&str]| -> (serde_json::Value, bool) {
+        let out_dir = tempfile::tempdir().unwrap();
+        let out = Command::new(env!("CARGO_BIN_EXE_rodstudy"))
+            .arg("fem")
+            .arg(&design)
+            .arg("--mesh")
+            .arg(meshes().join("design1.msh"))
+            .args(["--force", "7202", "--json", "--no-pictures", "--out"])
+            .arg(out_dir.path())
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let mode = out_dir.path().join("buckling_mode.vtu").is_file();
+        (serde_json::from_slice(&out.stdout).unwrap(), mode)
+    };
+    let (with, with_mode) = run(&[]);
+    let (without, without_mode) = run(&["--no-buckling"]);
+    assert!(with["buckling_load_factor"].as_f64().unwrap() > 0.0);
+    assert!(with["buckling_s"].as_f64().unwrap() > 0.0);
+    assert!(with["buckling_iterations"].as_u64().unwrap() >= 2);
+    assert!(with_mode);
+    for key in ["buckling_load_factor", "buckling_s", "buckling_iterations"] {
+        assert!(without[key].is_null(), "{key}: {}", without[key]);
+    }
+    assert!(!without_mode);
+    for case in ["fx", "fy"] {
+        for key in [
+            "max_von_mises_away_from_fixed_mpa",
+            "max_displacement_mm",
+            "estimated_error_rel",
+        ] {
+            assert_eq!(with[case][key], without[case][key], "{case}: {key}");
+        }
+    }
+}
