@@ -215,7 +215,7 @@ pub fn bench_fem_mesh(
     let secs = std::time::Duration::from_secs_f64;
     phase("analysis: assembly", secs(t.assembly_s), true);
     phase(
-        "analysis: symbolic analysis (AMD ordering)",
+        "analysis: symbolic analysis (nested-dissection ordering)",
         secs(t.symbolic_s),
         true,
     );

@@ -38,6 +38,7 @@ use super::error::{FemError, Result};
 use super::geometric_stiffness::{GeometricKernel, geometric_kernel};
 use super::material::Material;
 use super::mesh::TetMesh;
+use super::ordering::nested_dissection;
 use super::solver::{CholeskyFactor, SymbolicFactor};
 use super::statics::FactorisedSystem;
 
@@ -226,7 +227,10 @@ pub fn solve_buckling(
         return Err(FemError::InvalidInput("every DOF is prescribed".into()));
     }
     let asm = assemble(mesh, &problem.material, problem.quadrature, &dofs)?;
-    let symbolic = SymbolicFactor::analyse(&asm.k)?;
+    let symbolic = {
+        let order = nested_dissection(mesh, &dofs)?;
+        SymbolicFactor::analyse(&asm.k, Some(&order))?
+    };
     let factor = CholeskyFactor::factorise(&symbolic, &asm.k)?;
     let system = FactorisedSystem {
         dofs,

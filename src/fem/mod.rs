@@ -39,6 +39,7 @@ pub mod load;
 pub mod material;
 pub mod mesh;
 pub mod nodal_stress;
+pub mod ordering;
 pub mod quadrature;
 pub mod recovery;
 pub mod refinement;

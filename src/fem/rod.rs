@@ -17,12 +17,12 @@ use super::boundary::{boundary_faces, cross, norm};
 use super::element::QuadratureChoice;
 use super::error::{FemError, Result};
 use super::estimate::{ErrorEstimate, EstimateSummary, estimate_error};
-use super::load::{BoreLoad, pin_load};
+use super::load::{BoreLoad, SurfaceLoad, pin_load};
 use super::material::Material;
 use super::mesh::TetMesh;
 use super::recovery::recover_stress;
 use super::statics::{
-    FactorisedSystem, StaticProblem, Timings, solve_static, solve_static_reusing,
+    FactorisedSystem, StaticProblem, StaticSolution, Timings, solve_static, solve_static_reusing,
 };
 use super::stress::{
     StressField, displacement_magnitudes, nodes_away_from, nodes_away_from_segments, peak_nodal,
@@ -327,6 +327,37 @@ pub fn solve_rod_fields(
     force_n: f64,
     options: &RodOptions,
 ) -> Result<RodSolution> {
+    rod_fields(
+        solve_rod_static(mesh, material, bores, force_n, options)?,
+        options,
+    )
+}
+
+/// The first half of [`solve_rod_fields`]: the bores, the two pin loads and the static solution
+/// of both cases. What it does not read of `options` (the fixed band, the singular edges and their
+/// band, the fillet-kink count) [`rod_fields`] reads, so that a caller can work those out while K
+/// is factorised (on one thread, [`super::solver`]).
+pub struct RodStatic<'a> {
+    mesh: &'a TetMesh,
+    material: Material,
+    bores: BoreSpec,
+    t_all: Instant,
+    loaded: BoreSurface,
+    fixed: BoreSurface,
+    cases: [(&'static str, [f64; 3], f64); 2],
+    loads: Vec<SurfaceLoad>,
+    sol: StaticSolution,
+    system: Option<Arc<FactorisedSystem>>,
+}
+
+/// The bores, loads and static solution of both cases ([`RodStatic`]).
+pub fn solve_rod_static<'a>(
+    mesh: &'a TetMesh,
+    material: &Material,
+    bores: &BoreSpec,
+    force_n: f64,
+    options: &RodOptions,
+) -> Result<RodStatic<'a>> {
     let t_all = Instant::now();
     material.validate()?;
     let fy_force_n = options.fy_force_n.unwrap_or(force_n);
@@ -373,7 +404,37 @@ pub fn solve_rod_fields(
     } else {
         (solve_static(&problem)?, None)
     };
+    Ok(RodStatic {
+        mesh,
+        material: *material,
+        bores: bores.clone(),
+        t_all,
+        loaded,
+        fixed,
+        cases,
+        loads,
+        sol,
+        system,
+    })
+}
 
+/// The second half of [`solve_rod_fields`]: stresses, recovery, error estimates and peaks of
+/// both cases of `st`, the peaks judged away from the fixed bore and from the singular edges of
+/// `options`.
+pub fn rod_fields(st: RodStatic<'_>, options: &RodOptions) -> Result<RodSolution> {
+    let RodStatic {
+        mesh,
+        material,
+        bores,
+        t_all,
+        loaded,
+        fixed,
+        cases,
+        loads,
+        sol,
+        system,
+    } = st;
+    let (material, bores) = (&material, &bores);
     let t_stress = Instant::now();
     let band = options.fixed_band_m.unwrap_or(DEFAULT_FIXED_BAND_M);
     let singular_band = options.singular_band_m.unwrap_or(DEFAULT_SINGULAR_BAND_M);

@@ -12,6 +12,7 @@ use super::element::{QuadratureChoice, element_stiffness};
 use super::error::{FemError, Result};
 use super::material::Material;
 use super::mesh::TetMesh;
+use super::ordering::nested_dissection;
 use super::solver::{CholeskyFactor, SymbolicFactor};
 
 /// A linear static problem on a mesh.
@@ -131,7 +132,10 @@ pub fn solve_static_reusing(
     let t = Instant::now();
     let symbolic = match symbolic {
         Some(s) if s.matches(&asm.k) => s.clone(),
-        _ => SymbolicFactor::analyse(&asm.k)?,
+        _ => {
+            let order = nested_dissection(mesh, &dofs)?;
+            SymbolicFactor::analyse(&asm.k, Some(&order))?
+        }
     };
     timings.symbolic_s = t.elapsed().as_secs_f64();
     let t = Instant::now();

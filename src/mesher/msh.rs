@@ -83,6 +83,22 @@ fn line_of(bytes: &[u8], offset: usize) -> usize {
         .count()
 }
 
+/// The end of the `$EndElements` line (the sections a mesh needs, `$MeshFormat` to `$Elements`), or
+/// the whole file without one (mshio then reports the missing section).
+fn mesh_sections_end(bytes: &[u8]) -> usize {
+    const END: &[u8] = b"\n$EndElements";
+    bytes
+        .windows(END.len())
+        .position(|w| w == END)
+        .map_or(bytes.len(), |i| {
+            let after = i + END.len();
+            match bytes[after..].iter().position(|&b| b == b'\n') {
+                Some(nl) => after + nl + 1,
+                None => bytes.len(),
+            }
+        })
+}
+
 /// Reads the tetrahedra of a gmsh MSH 4.1 file (ASCII or binary); see the module documentation.
 pub fn read_msh(path: &Path) -> Result<RawVolume> {
     let bytes = std::fs::read(path).map_err(|e| FemError::io(path, e))?;
@@ -102,7 +118,11 @@ pub fn read_msh(path: &Path) -> Result<RawVolume> {
             format!("file type {file_type} / data size {data_size}: expected 0 or 1 and 4 or 8"),
         ));
     }
-    let msh = mshio::parse_msh_bytes(&bytes).map_err(|e| {
+    // what follows the elements (gmsh's $Periodic, $Parametrizations of a classified surface,
+    // $NodeData, …; MSH 4.1 orders the sections so) is not parsed: a gmsh-classified rod's
+    // reparametrisation is three quarters of its file and, in mshio, of its reading time
+    let bytes = &bytes[..mesh_sections_end(&bytes)];
+    let msh = mshio::parse_msh_bytes(bytes).map_err(|e| {
         let offset = e
             .backtrace
             .first()
@@ -116,7 +136,7 @@ pub fn read_msh(path: &Path) -> Result<RawVolume> {
                 None => k.to_string(),
             })
             .collect();
-        perr(path, line_of(&bytes, offset), what.join(": "))
+        perr(path, line_of(bytes, offset), what.join(": "))
     })?;
     let nodes_section = msh
         .data

@@ -30,7 +30,7 @@ use crate::fem::adapt::{AdaptOptions, adaptive_rod};
 use crate::fem::buckling::{BucklingMode, BucklingOptions, BucklingSolution};
 use crate::fem::facets::{FacetScale, MAX_FILLET_RADIUS_MM, SurfaceEdges};
 use crate::fem::refinement::{RefinementStudy, refinement_study};
-use crate::fem::rod::{RodSolution, solve_rod_fields};
+use crate::fem::rod::{RodSolution, rod_fields, solve_rod_fields, solve_rod_static};
 use crate::fem::rod_buckling::rod_buckling;
 use crate::fem::smooth::{SmoothSurface, geometry_check};
 use crate::fem::statics::FactorisedSystem;
@@ -239,8 +239,8 @@ struct Setup {
     step: Option<StepInRodFrame>,
     bores: BoreSpec,
     material: Material,
-    /// The surface's edges: kinks, faceted small fillets, sharp edges.
-    edges: SurfaceEdges,
+    /// The surface's edges: kinks, faceted small fillets, sharp edges ([`Setup::edges`]).
+    edges: Option<SurfaceEdges>,
     /// The caller keeps the factorised K of the final mesh (buckling on it).
     keep_system: bool,
     singular_edges: Vec<[[f64; 3]; 2]>,
@@ -255,7 +255,7 @@ impl Setup {
     /// `for_gmsh`: the surface is what gmsh will mesh (simplified); else a given mesh is solved
     /// and the surface only tells the sharp re-entrant edges. With a pressure trace the F_y case
     /// carries the largest pin force across the rod over the engine's cycle ([`engine_loads`]).
-    fn new(
+    fn without_edges(
         design: &LoadedDesign,
         config: &StudyConfig,
         for_gmsh: bool,
@@ -266,26 +266,13 @@ impl Setup {
             .with_context(|| context.clone())?
             .and_then(|d| d.peak_transverse_n);
         let surface = rod_frame_surface(design, for_gmsh);
-        let edges = SurfaceEdges::new(
-            &surface.vertices,
-            &surface.triangles,
-            FEATURE_ANGLE_DEG,
-            MAX_FILLET_RADIUS_MM,
-        );
-        let singular_edges: Vec<[[f64; 3]; 2]> = edges
-            .sharp_reentrant(&surface.vertices)
-            .into_iter()
-            .map(|s| s.map(|p| p.map(|v| v * 1e-3)))
-            .collect();
         let rod = RodOptions {
             fixed_band_m: Some(config.fem.fixed_band_mm * 1e-3),
-            singular_edges_m: singular_edges.clone(),
             singular_band_m: Some(config.fem.singular_band_mm * 1e-3),
             fy_force_n,
             // the STL route keeps the last solve's system: the geometry check reuses its symbolic
             // analysis
             keep_system: keep_system || (for_gmsh && design.format.step().is_none()),
-            fillet_kink_edges: edges.fillet_kinks(),
             ..RodOptions::default()
         };
         let step = design.format.step().map(|_| {
@@ -310,12 +297,57 @@ impl Setup {
             bores,
             surface,
             material: Material::from(&config.fem),
-            edges,
+            edges: None,
             keep_system,
-            singular_edges,
+            singular_edges: Vec::new(),
             rod,
             context,
         })
+    }
+
+    /// [`Setup::without_edges`] with the surface's edges ([`Setup::set_edges`]).
+    fn new(
+        design: &LoadedDesign,
+        config: &StudyConfig,
+        for_gmsh: bool,
+        keep_system: bool,
+    ) -> Result<Self> {
+        let mut setup = Self::without_edges(design, config, for_gmsh, keep_system)?;
+        let edges = setup.surface_edges();
+        setup.set_edges(edges);
+        Ok(setup)
+    }
+
+    /// The surface's edges classified, and its sharp re-entrant edges (segments, m).
+    fn surface_edges(&self) -> (SurfaceEdges, Vec<[[f64; 3]; 2]>) {
+        let edges = SurfaceEdges::new(
+            &self.surface.vertices,
+            &self.surface.triangles,
+            FEATURE_ANGLE_DEG,
+            MAX_FILLET_RADIUS_MM,
+        );
+        let singular = edges
+            .sharp_reentrant(&self.surface.vertices)
+            .into_iter()
+            .map(|s| s.map(|p| p.map(|v| v * 1e-3)))
+            .collect();
+        (edges, singular)
+    }
+
+    /// Sets the edges of [`Setup::surface_edges`] and what the rod analysis takes of them.
+    fn set_edges(&mut self, (edges, singular): (SurfaceEdges, Vec<[[f64; 3]; 2]>)) {
+        self.rod.singular_edges_m = singular.clone();
+        self.rod.fillet_kink_edges = edges.fillet_kinks();
+        self.singular_edges = singular;
+        self.edges = Some(edges);
+    }
+
+    /// The surface's edges ([`Setup::set_edges`] has set them: every constructor but
+    /// [`Setup::without_edges`] does).
+    fn edges(&self) -> &SurfaceEdges {
+        self.edges
+            .as_ref()
+            .expect("the surface's edges are set before they are used")
     }
 
     /// The gmsh adapter on this surface (writes `work_dir/rod_frame.stl`), or on the exact
@@ -402,7 +434,7 @@ impl Setup {
             let surface = SmoothSurface::new(
                 &self.surface.vertices,
                 &self.surface.triangles,
-                &self.edges,
+                self.edges(),
                 2.0,
             );
             let rod = RodOptions {
@@ -497,7 +529,7 @@ pub fn fem_adaptive(
 ) -> Result<FemOutcome> {
     let setup = Setup::new(design, config, true, keep_system)?;
     let mut mesher = setup.mesher(work_dir)?;
-    let facets = FacetScale::from_edges(&setup.edges, &setup.surface.vertices, 2.0);
+    let facets = FacetScale::from_edges(setup.edges(), &setup.surface.vertices, 2.0);
     // an STL's facets set a floor below which refinement resolves the facets, not the part; the
     // exact geometry of a STEP has none
     let exact = setup.step.is_some();
@@ -585,13 +617,13 @@ pub fn fem_user_mesh(
             let start = std::time::Instant::now();
             read_volume_mesh(file, "mm", work_dir).map(|(m, _)| (m, start.elapsed()))
         });
-        let setup = Setup::new(design, config, false, keep_system);
+        let setup = Setup::without_edges(design, config, false, keep_system);
         let read = reading
             .join()
             .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
         (setup, read)
     });
-    let setup = setup?;
+    let mut setup = setup?;
     let (read, read_time) =
         read.with_context(|| format!("{}: cannot use this volume mesh", file.display()))?;
     let start = std::time::Instant::now();
@@ -606,7 +638,15 @@ pub fn fem_user_mesh(
         .with_context(|| format!("{}: the mesh in the rod frame", file.display()))?;
     // reading and moving the mesh, not the analysis (fem.total_s)
     let mesh_seconds = (read_time + start.elapsed()).as_secs_f64();
-    let solution = solve_rod_fields(&mesh, &setup.material, &setup.bores, force_n, &setup.rod)
+    // the surface's sharp edges matter only to the stresses' post-processing: worked out while K
+    // is factorised (on one thread)
+    let (solved, edges) = rayon::join(
+        || solve_rod_static(&mesh, &setup.material, &setup.bores, force_n, &setup.rod),
+        || setup.surface_edges(),
+    );
+    setup.set_edges(edges);
+    let solution = solved
+        .and_then(|st| rod_fields(st, &setup.rod))
         .with_context(|| setup.context.clone())?;
     let summary = MeshSummary {
         source: file.display().to_string(),
