@@ -252,9 +252,11 @@ struct Setup {
 const FRAME: &str = "rod frame, mm: origin at the crank pin A, x along A→B, z along the pin axis";
 
 impl Setup {
-    /// `for_gmsh`: the surface is what gmsh will mesh (simplified); else a given mesh is solved
-    /// and the surface only tells the sharp re-entrant edges. With a pressure trace the F_y case
-    /// carries the largest pin force across the rod over the engine's cycle ([`engine_loads`]).
+    /// Everything but the surface's edges, which [`Setup::set_edges`] adds (a given mesh works
+    /// them out while K is factorised, [`fem_user_mesh`]). `for_gmsh`: the surface is what gmsh
+    /// will mesh (simplified); else a given mesh is solved and the surface only tells the sharp
+    /// re-entrant edges. With a pressure trace the F_y case carries the largest pin force across
+    /// the rod over the engine's cycle ([`engine_loads`]).
     fn without_edges(
         design: &LoadedDesign,
         config: &StudyConfig,
