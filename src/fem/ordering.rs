@@ -40,7 +40,11 @@ pub fn nested_dissection(mesh: &TetMesh, dofs: &DofMap) -> Result<Vec<usize>> {
             adj[cb].push(ca as u32);
         }
     }
-    let too_big = || FemError::Solver(format!("{n_nodes} nodes exceed METIS's 32-bit indices"));
+    let too_big = || {
+        FemError::Solver(format!(
+            "{n_nodes} nodes exceed METIS's 32-bit indices: mesh coarser (a larger element size)"
+        ))
+    };
     let mut xadj: Vec<m::idx_t> = Vec::with_capacity(nc + 1);
     let mut adjncy: Vec<m::idx_t> = Vec::new();
     xadj.push(0);
@@ -79,8 +83,11 @@ fn metis_node_nd(mut xadj: Vec<m::idx_t>, mut adjncy: Vec<m::idx_t>) -> Result<V
     if n == 0 {
         return Ok(Vec::new());
     }
-    let mut nvtxs = m::idx_t::try_from(n)
-        .map_err(|_| FemError::Solver(format!("{n} vertices exceed METIS's 32-bit indices")))?;
+    let mut nvtxs = m::idx_t::try_from(n).map_err(|_| {
+        FemError::Solver(format!(
+            "{n} corner nodes exceed METIS's 32-bit indices: mesh coarser (a larger element size)"
+        ))
+    })?;
     let mut options = [0 as m::idx_t; m::METIS_NOPTIONS as usize];
     let mut perm = vec![0 as m::idx_t; n];
     let mut iperm = vec![0 as m::idx_t; n];
@@ -110,7 +117,8 @@ fn metis_node_nd(mut xadj: Vec<m::idx_t>, mut adjncy: Vec<m::idx_t>) -> Result<V
     };
     if status != m::rstatus_et_METIS_OK {
         return Err(FemError::Solver(format!(
-            "METIS_NodeND failed (status {status})"
+            "the fill-reducing ordering failed (METIS_NodeND status {status}: out of memory, or a mesh \
+             graph METIS refuses); mesh coarser or check the mesh's connectivity"
         )));
     }
     // METIS: row i of the permuted matrix is row perm[i] of the original; iperm is its inverse.
