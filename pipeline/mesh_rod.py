@@ -25,7 +25,8 @@ Two commands, both ending with one line of JSON on standard output (progress goe
       file the Rust side reads, see below). The .rodmesh is made from the .msh through meshio, i.e.
       by the very same code path as `convert`. With --no-rodmesh it is not written: the caller reads
       the .msh with its native MSH 4.1 reader (the same mesh bit for bit; rodstudy's adaptive meshes,
-      which saves meshio's 0.5 s per mesh).
+      which saves meshio's 0.5 s per mesh). (Binary MSH would be 0.1 s faster to write, but its
+      exact coordinates, where ASCII prints 16 digits, change the loop's later meshes: not adopted.)
       JSON: paths, node and element counts, min/mean scaled Jacobian and SICN (gmsh
       `getElementQualities` "minSJ" / "minSICN"), whether elements are curved, timings, the
       fallback used (`fallback`, `fallback_detail`: rounds and refined patches, or the boundary
@@ -64,6 +65,20 @@ Two commands, both ending with one line of JSON on standard output (progress goe
       floor: the geometry is exact. An element that stays inverted after the optimiser (minimum
       scaled Jacobian <= 0) is refused with a message, never handed to the solver. Same outputs
       and JSON as `mesh` (`curved` true, `classify_angle_deg` 0).
+
+  mesh_rod.py serve STL --geometry FILE
+      One gmsh session for a whole adaptive sequence of meshes of one STL (rodstudy's stage 3): one
+      JSON request per line on standard input, {"size": mm, "size_field": FILE or null, "out_dir":
+      DIR, "name": NAME}, one JSON reply per line on standard output, the fields of `mesh`'s (read
+      natively, as `--no-rodmesh`). gmsh starts once; every request then takes the steps of `mesh`'s
+      first attempt in it on a new model (the cached classification of --geometry, else the
+      ladder's first rung, cached after its first mesh; HXT), the same mesh bit for bit as `mesh`
+      in a fresh process. This saves two Python start-ups and gmsh's start per mesh. Only the
+      usual route is served: the first error (HXT's sliver, a classification that does not mesh)
+      is replied as {"error": ...} and ends the session; the caller then uses `mesh`, with its
+      ladder, Delaunay and fallbacks. (Keeping the reparametrised model between meshes would save
+      0.25 s more, but remeshing it needs its classified triangles cleared first, which changes the
+      meshes and made design 5's first mesh fail.)
 
   mesh_rod.py convert IN OUT [--units mm|m]
       A ready volume mesh (gmsh .msh, Abaqus/CalculiX .inp, VTU, Nastran .bdf/.nas, anything meshio
@@ -184,8 +199,12 @@ def gmsh_options(size_mm: float, curved: bool, size_field: bool = False) -> dict
         opts["Mesh.MeshSizeExtendFromBoundary"] = 0
         # the curves' 1D mesh integrates 1/size along each curve to this relative precision; the
         # default 1e-9 made gmsh evaluate the piecewise-linear field so often that the 1D mesh
-        # took 0.8 s of a 1.5 s mesh (design 1); at 1e-6, 0.23 s, the same number of nodes to 0.2 %
+        # took 0.8 s of a 1.5 s mesh (design 1); at 1e-6, 0.23 s, the same number of nodes to 0.2 %.
+        # (1e-3 is 0.2 s faster again on design 1's second mesh, but its slightly different meshes
+        # took designs 2 and 4 through five meshes instead of four and three: not adopted)
         opts["Mesh.LcIntegrationPrecision"] = 1e-6
+    else:
+        opts["Mesh.LcIntegrationPrecision"] = 1e-9  # gmsh's default (a session's later mesh resets it)
     return opts
 
 
@@ -249,6 +268,69 @@ def tet10_qualities() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return tags10, min_sj, min_sicn
 
 
+def build_volume(stl: pathlib.Path, angle_deg: float, curve_angle_deg: float,
+                 geometry_in: pathlib.Path | None = None, geometry_out: pathlib.Path | None = None) -> int:
+    """The model "rod": the STL's surface classified into patches (or the classification of
+    `geometry_in`), reparametrised (`createGeometry`), closed into one volume. Returns the number of
+    surface patches."""
+    import gmsh
+
+    gmsh.model.add("rod")
+    if geometry_in is not None:
+        gmsh.merge(str(geometry_in))
+    else:
+        gmsh.merge(str(stl))
+        # Patches from the triangle soup: split at sharp edges (angle in radians), keep
+        # boundaries, make each patch parametrisable so that it can be remeshed at the target size.
+        gmsh.model.mesh.classifySurfaces(math.radians(angle_deg), True, True, math.radians(curve_angle_deg))
+        if geometry_out is not None:
+            # written and read back, so that a first mesh and a later one from the cached
+            # classification start from the same data (same mesh, bit for bit)
+            gmsh.write(str(geometry_out))
+            gmsh.clear()
+            gmsh.merge(str(geometry_out))
+    gmsh.model.mesh.createGeometry()
+    surfaces = [tag for _, tag in gmsh.model.getEntities(2)]
+    loop = gmsh.model.geo.addSurfaceLoop(surfaces)
+    gmsh.model.geo.addVolume([loop])
+    gmsh.model.geo.synchronize()
+    return len(surfaces)
+
+
+def mesh_volume(msh_out: pathlib.Path, size_field: pathlib.Path | None, delaunay: bool) -> dict:
+    """Meshes the volume of `build_volume`'s model (options set by the caller) and writes it to
+    `msh_out`. The model still holds the classified STL triangles on its patches, as
+    `createGeometry` leaves them: gmsh remeshes from that state (clearing them first changes the
+    meshes and made design 5's first mesh fail with overlapping facets)."""
+    import gmsh
+
+    size_field_tets = add_size_field(size_field)[0] if size_field is not None else 0
+    t1 = time.perf_counter()
+    gmsh.model.mesh.generate(3)
+    t2 = time.perf_counter()
+    tags10, min_sj, min_sicn = tet10_qualities()
+    if delaunay is False and min_sicn.min() < MIN_SICN:
+        # HXT can leave a sliver its optimiser does not remove; the caller retries with
+        # Delaunay + Netgen, whose optimiser does
+        raise RuntimeError(f"HXT left a sliver (min SICN {min_sicn.min():.2e} < {MIN_SICN})")
+    return {
+        **written_mesh((tags10, min_sj, min_sicn), msh_out),
+        "size_field_tetrahedra": size_field_tets,
+        "algorithm_3d": {10: "hxt", 1: "delaunay"}.get(int(gmsh.option.getNumber("Mesh.Algorithm3D")), "?"),
+        "seconds_mesh": t2 - t1,
+        "gmsh_version": gmsh.option.getString("General.Version"),
+    }
+
+
+def set_options(size_mm: float, curved: bool, size_field: bool, delaunay: bool) -> None:
+    import gmsh
+
+    for k, v in gmsh_options(size_mm, curved, size_field).items():
+        gmsh.option.setNumber(k, v)
+    if delaunay:
+        gmsh.option.setNumber("Mesh.Algorithm3D", 1)
+
+
 def gmsh_volume_mesh(stl: pathlib.Path, size_mm: float, curved: bool, angle_deg: float,
                      curve_angle_deg: float, msh_out: pathlib.Path, size_field: pathlib.Path | None = None,
                      geometry_in: pathlib.Path | None = None,
@@ -258,47 +340,15 @@ def gmsh_volume_mesh(stl: pathlib.Path, size_mm: float, curved: bool, angle_deg:
     t0 = time.perf_counter()
     gmsh.initialize(["mesh_rod"], readConfigFiles=False)
     try:
-        for k, v in gmsh_options(size_mm, curved, size_field is not None).items():
-            gmsh.option.setNumber(k, v)
-        if delaunay:
-            gmsh.option.setNumber("Mesh.Algorithm3D", 1)
-        gmsh.model.add("rod")
-        if geometry_in is not None:
-            gmsh.merge(str(geometry_in))
-        else:
-            gmsh.merge(str(stl))
-            # Patches from the triangle soup: split at sharp edges (angle in radians), keep
-            # boundaries, make each patch parametrisable so that it can be remeshed at the target size.
-            gmsh.model.mesh.classifySurfaces(math.radians(angle_deg), True, True, math.radians(curve_angle_deg))
-            if geometry_out is not None:
-                # written and read back, so that a first mesh and a later one from the cached
-                # classification start from the same data (same mesh, bit for bit)
-                gmsh.write(str(geometry_out))
-                gmsh.clear()
-                gmsh.merge(str(geometry_out))
-        gmsh.model.mesh.createGeometry()
-        surfaces = [tag for _, tag in gmsh.model.getEntities(2)]
-        loop = gmsh.model.geo.addSurfaceLoop(surfaces)
-        gmsh.model.geo.addVolume([loop])
-        gmsh.model.geo.synchronize()
-        size_field_tets = add_size_field(size_field)[0] if size_field is not None else 0
+        set_options(size_mm, curved, size_field is not None, delaunay)
+        patches = build_volume(stl, angle_deg, curve_angle_deg, geometry_in, geometry_out)
         t1 = time.perf_counter()
-        gmsh.model.mesh.generate(3)
-        t2 = time.perf_counter()
-        tags10, min_sj, min_sicn = tet10_qualities()
-        if delaunay is False and min_sicn.min() < MIN_SICN:
-            # HXT can leave a sliver its optimiser does not remove; the caller retries with
-            # Delaunay + Netgen, whose optimiser does
-            raise RuntimeError(f"HXT left a sliver (min SICN {min_sicn.min():.2e} < {MIN_SICN})")
+        info = mesh_volume(msh_out, size_field, delaunay)
         return {
-            **written_mesh((tags10, min_sj, min_sicn), msh_out),
-            "surface_patches": len(surfaces),
-            "size_field_tetrahedra": size_field_tets,
-            "algorithm_3d": {10: "hxt", 1: "delaunay"}.get(int(gmsh.option.getNumber("Mesh.Algorithm3D")), "?"),
+            **info,
+            "surface_patches": patches,
             "geometry_reused": geometry_in is not None,
             "seconds_geometry": t1 - t0,
-            "seconds_mesh": t2 - t1,
-            "gmsh_version": gmsh.option.getString("General.Version"),
         }
     finally:
         gmsh.finalize()
@@ -496,16 +546,9 @@ def gmsh_local_refinement(stl: pathlib.Path, size_mm: float, angle_deg: float, c
     for rounds in range(LOCAL_ROUNDS + 1):
         gmsh.initialize(["mesh_rod"], readConfigFiles=False)
         try:
-            for k, v in gmsh_options(size_mm, False, size_field is not None).items():
-                gmsh.option.setNumber(k, v)
-            gmsh.option.setNumber("Mesh.Algorithm3D", 1)  # Delaunay: its errors name the surfaces
-            gmsh.model.add("rod")
-            gmsh.merge(str(classified))
-            gmsh.model.mesh.createGeometry()
-            surfaces = [tag for _, tag in gmsh.model.getEntities(2)]
-            loop = gmsh.model.geo.addSurfaceLoop(surfaces)
-            gmsh.model.geo.addVolume([loop])
-            gmsh.model.geo.synchronize()
+            # Delaunay: its errors name the surfaces
+            set_options(size_mm, False, size_field is not None, delaunay=True)
+            patches = build_volume(stl, angle_deg, curve_angle_deg, geometry_in=classified)
             size_field_tets, base = add_size_field(size_field, background=False) if size_field else (0, None)
             if refine:
                 add_refinement(refine, size_mm, base)
@@ -541,7 +584,7 @@ def gmsh_local_refinement(stl: pathlib.Path, size_mm: float, angle_deg: float, c
             t2 = time.perf_counter()
             return {
                 **written_mesh(tet10_qualities(), msh_out),
-                "surface_patches": len(surfaces),
+                "surface_patches": patches,
                 "size_field_tetrahedra": size_field_tets,
                 "algorithm_3d": "delaunay",
                 "geometry_reused": geometry_in is not None,
@@ -790,6 +833,132 @@ def cmd_mesh(args) -> dict:
     return info
 
 
+def cmd_serve(args) -> None:
+    """`serve`: one gmsh session for a whole adaptive sequence (see the module's doc). One JSON
+    request per line on standard input, one JSON reply per line on standard output; the first
+    error is replied and ends the session (the caller meshes the rest with `mesh`)."""
+    import gmsh
+
+    # the replies get their own copy of standard output; whatever gmsh's C++ side prints itself
+    # (it does print some errors, Terminal 0 or not) goes to standard error with the log
+    replies = os.fdopen(os.dup(1), "w")
+    os.dup2(2, 1)
+    stl = pathlib.Path(args.stl)
+    geometry = pathlib.Path(args.geometry)
+    if not stl.is_file():
+        raise SystemExit(f"mesh_rod: no such STL file: {stl}")
+    gmsh.initialize(["mesh_rod"], readConfigFiles=False)
+    gmsh.option.setNumber("General.Terminal", 0)
+    state = {"prepared": None}
+    try:
+        while True:
+            line = sys.stdin.readline()
+            if not line:
+                return
+            if not line.strip():
+                continue
+            try:
+                reply = served_mesh(json.loads(line), stl, geometry, state)
+            except Exception as e:  # noqa: BLE001 - every failure is replied, then the session ends
+                replies.write(json.dumps({"error": f"{type(e).__name__}: {e}"}) + "\n")
+                replies.flush()
+                return
+            replies.write(json.dumps(reply, sort_keys=True) + "\n")
+            replies.flush()
+            prepare_next(geometry, state)
+    finally:
+        gmsh.finalize()
+
+
+def cached_classification(geometry: pathlib.Path) -> tuple[float, float] | None:
+    """The classification setting cached beside `geometry` (`mesh --geometry`'s FILE.json)."""
+    meta = geometry.with_name(geometry.name + ".json")
+    if not (geometry.is_file() and meta.is_file()):
+        return None
+    cached = json.loads(meta.read_text())
+    return cached["classify_angle_deg"], cached["curve_angle_deg"]
+
+
+def prepare_next(geometry: pathlib.Path, state: dict) -> None:
+    """Builds the next mesh's model from the cached classification while the caller works on the
+    mesh just replied (its solve takes a second or more on the other core): a new model, read and
+    reparametrised as a fresh process does it (0.3 s of each later mesh). The options are set
+    again before meshing; those in force while the model is built do not change the mesh (design
+    1's and design 5's size-field meshes compared file for file, and `tests/gmsh_session.rs`)."""
+    import gmsh
+
+    state["prepared"] = None
+    classification = cached_classification(geometry)
+    if classification is None:
+        return
+    try:
+        gmsh.clear()
+        patches = build_volume(pathlib.Path(), *classification, geometry, None)
+    except Exception as e:  # noqa: BLE001 - the next request builds its model itself
+        log(f"preparing the next model failed ({e}); the next request builds it")
+        return
+    state["prepared"] = (classification, patches)
+
+
+def served_mesh(request: dict, stl: pathlib.Path, geometry: pathlib.Path, state: dict) -> dict:
+    """One mesh of `serve`: the steps of `mesh`'s first attempt (HXT; the cached classification,
+    else the ladder's first rung, which becomes the cache once it has made a mesh), in the running
+    gmsh, on the model `prepare_next` built where it is that classification's."""
+    import gmsh
+
+    t0 = time.perf_counter()
+    size = float(request["size"])
+    if not (size > 0 and math.isfinite(size)):
+        raise ValueError(f"size must be a positive number of mm, got {size}")
+    size_field = pathlib.Path(request["size_field"]) if request.get("size_field") else None
+    if size_field is not None and not size_field.is_file():
+        raise ValueError(f"no such size field file: {size_field}")
+    out_dir = pathlib.Path(request["out_dir"])
+    out_dir.mkdir(parents=True, exist_ok=True)
+    msh = out_dir / f"{request.get('name') or stl.stem}.msh"
+    meta = geometry.with_name(geometry.name + ".json")
+    cached = cached_classification(geometry)
+    reused = cached is not None
+    angle, curve_angle = cached if reused else LADDER[0]
+    geo_out = None if reused else geometry.with_name(geometry.name + ".tmp.msh")
+    log(f"{stl.name}: meshing at {size} mm (classification {angle:g} deg, curves {curve_angle:g} deg)"
+        + (", size field" if size_field else "") + (", classified surface reused" if reused else "")
+        + ", gmsh session")
+    prepared, state["prepared"] = state["prepared"], None
+    if reused and prepared is not None and prepared[0] == (angle, curve_angle):
+        patches = prepared[1]
+        set_options(size, False, size_field is not None, False)
+    else:
+        # a new model, as a fresh process starts it (options, fields and views reset)
+        gmsh.clear()
+        set_options(size, False, size_field is not None, False)
+        patches = build_volume(stl, angle, curve_angle, geometry if reused else None, geo_out)
+    t1 = time.perf_counter()
+    info = mesh_volume(msh, size_field, False)
+    if geo_out is not None and geo_out.is_file():
+        geo_out.replace(geometry)
+        meta.write_text(json.dumps({"classify_angle_deg": angle, "curve_angle_deg": curve_angle}))
+    info.update({
+        "surface_patches": patches,
+        "geometry_reused": reused,
+        "seconds_geometry": t1 - t0,
+        "classify_angle_deg": angle,
+        "curve_angle_deg": curve_angle,
+        "curved": False,
+        "stl": str(stl),
+        "msh": str(msh),
+        "size_mm": size,
+        "failed_attempts": [],
+        "fallback": None,
+        "rodmesh": None,
+        "nodes": info["gmsh_nodes"],
+    })
+    info["seconds_total"] = time.perf_counter() - t0
+    log(f"{info['elements']} tet10, {info['nodes']} nodes, min SICN {info['min_sicn']:.3f}, "
+        f"min SJ {info['min_scaled_jacobian']:.3f}, {info['seconds_total']:.1f} s")
+    return info
+
+
 def gmsh_step_mesh(step: pathlib.Path, frame: list, scale: float, size_mm: float, msh_out: pathlib.Path,
                    size_field: pathlib.Path | None, delaunay: bool) -> dict:
     """One curved tet10 mesh of the STEP solid in the rod frame (see `mesh-step` above)."""
@@ -1025,7 +1194,13 @@ def main(argv=None) -> int:
     pc.add_argument("input")
     pc.add_argument("output")
     pc.add_argument("--units", default="mm", help="units of the input coordinates: mm (default) or m")
+    pv = sub.add_parser("serve", help="one gmsh session for an adaptive sequence: JSON requests on stdin")
+    pv.add_argument("stl")
+    pv.add_argument("--geometry", required=True, help="the classified-surface cache, as `mesh --geometry`")
     args = ap.parse_args(argv)
+    if args.cmd == "serve":
+        cmd_serve(args)
+        return 0
     info = {"mesh": cmd_mesh, "mesh-step": cmd_mesh_step, "convert": cmd_convert,
             "_attempt": cmd_attempt, "_fallback": cmd_fallback}[args.cmd](args)
     print(json.dumps(info, sort_keys=True))

@@ -75,7 +75,7 @@ pub struct MeshedRod {
 /// Environment variable: the mesher's time limit in seconds (default 600).
 pub const MESHER_TIMEOUT_VAR: &str = "RODSTUDY_MESHER_TIMEOUT_S";
 
-fn mesher_timeout() -> Duration {
+pub(super) fn mesher_timeout() -> Duration {
     let secs = std::env::var(MESHER_TIMEOUT_VAR)
         .ok()
         .and_then(|v| v.parse::<f64>().ok())
@@ -176,7 +176,13 @@ fn run(python: &Path, script: &Path, args: &[&std::ffi::OsStr]) -> Result<(Strin
 /// [`super::volume`]), checked to hold the elements reported.
 fn run_mesher(python: &Path, script: &Path, args: &[&std::ffi::OsStr]) -> Result<MeshedRod> {
     let (json, secs) = run(python, script, args)?;
-    let mut report: MeshReport = serde_json::from_str(&json)
+    read_reported(&json, secs)
+}
+
+/// The mesh a JSON report of `mesh_rod.py` names (`secs`: the wall time measured here), read and
+/// checked against the report.
+pub(super) fn read_reported(json: &str, secs: f64) -> Result<MeshedRod> {
+    let mut report: MeshReport = serde_json::from_str(json)
         .map_err(|e| FemError::Mesher(format!("cannot parse the mesher's report ({e}): {json}")))?;
     report.seconds_wall = secs;
     let (mesh, file) = match &report.rodmesh {

@@ -4,13 +4,15 @@
 //! subprocess under a time limit ([`gmsh`]); meshes come back through the `.rodmesh` hand-off file
 //! ([`rodmesh`]); adaptive refinement hands gmsh a size map as a binary file ([`size_field`]).
 //! [`rod_mesher::GmshRodMesher`] puts these together behind [`crate::fem::adapt::Mesher`], the
-//! small trait the adaptive loop calls, so that the loop itself can be driven by an in-memory
+//! small trait the adaptive loop calls (its meshes made in one gmsh session,
+//! [`gmsh_session`], where that works), so that the loop itself can be driven by an in-memory
 //! mesher in tests.
 //!
 //! A user's ready volume mesh is read by [`volume::read_volume_mesh`]: gmsh MSH 4.1 ([`msh`], via
 //! the `mshio` crate) and Abaqus/CalculiX `.inp` ([`inp`]) natively, other formats through meshio.
 
 pub mod gmsh;
+pub mod gmsh_session;
 pub mod inp;
 pub mod msh;
 pub mod raw_volume;

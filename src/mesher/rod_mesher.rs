@@ -1,12 +1,14 @@
 //! The meshes of stage 3 from the rod-frame STL: one fixed-size mesh, or the meshes the adaptive
 //! loop asks for ([`crate::fem::adapt::Mesher`]), each in its own folder of the work directory,
-//! with gmsh's classified surface cached between them.
+//! with gmsh's classified surface cached between them; the loop's meshes of an STL in one gmsh
+//! session ([`GmshSession`]) while it serves them.
 
 use std::path::{Path, PathBuf};
 
 use super::gmsh::{
     MeshReport, MeshRequest, MeshedRod, StepInRodFrame, mesh_step_with, mesh_stl, mesh_stl_with,
 };
+use super::gmsh_session::GmshSession;
 use super::size_field::write_size_field;
 use crate::fem::adapt::{MeshAsk, Mesher};
 use crate::fem::error::{FemError, Result};
@@ -31,7 +33,16 @@ pub struct GmshRodMesher {
     /// The meshes that needed one of the mesher's fallbacks: `<fallback>` for the fixed mesh,
     /// `mesh <iteration>: <fallback>` for an adaptive one.
     pub fallbacks: Vec<String>,
+    /// The gmsh session of the adaptive loop, while it serves (started by the first mesh).
+    session: Option<GmshSession>,
+    /// Whether the loop may still use a session (not for a STEP, not after one failed, not with
+    /// `RODSTUDY_GMSH_SESSION=0`).
+    session_wanted: bool,
 }
+
+/// Environment variable: `0` makes every mesh of the adaptive loop in a fresh process (the same
+/// meshes; for comparing the two routes, or if a session misbehaves).
+pub const GMSH_SESSION_VAR: &str = "RODSTUDY_GMSH_SESSION";
 
 impl GmshRodMesher {
     /// A mesher of the binary STL `stl_bytes` (written to `work_dir/rod_frame.stl`) whose meshes
@@ -59,13 +70,52 @@ impl GmshRodMesher {
             label: label.to_string(),
             last_report: None,
             fallbacks: Vec::new(),
+            session: None,
+            session_wanted: std::env::var(GMSH_SESSION_VAR).map_or(true, |v| v != "0"),
         })
     }
 
     /// Meshes the exact geometry of `step` (curved tet10) instead of the STL surface.
     pub fn with_step(mut self, step: StepInRodFrame) -> Self {
         self.step = Some(step);
+        self.session_wanted = false;
         self
+    }
+
+    /// The mesh of `ask` from the gmsh session (started on first use), or `None` where the
+    /// session does not serve: a STEP, a session that has failed (it is dropped, and says why
+    /// once), or `RODSTUDY_GMSH_SESSION=0`.
+    fn mesh_in_session(
+        &mut self,
+        ask: &MeshAsk<'_>,
+        field: Option<&Path>,
+        dir: &Path,
+    ) -> Option<MeshedRod> {
+        if !self.session_wanted {
+            return None;
+        }
+        let meshed = match &mut self.session {
+            Some(session) => session.mesh(ask.size_m * 1e3, field, dir, "rod"),
+            None => GmshSession::start(&self.python, &self.script, &self.stl, &self.geometry)
+                .and_then(|session| {
+                    let session = self.session.insert(session);
+                    session.mesh(ask.size_m * 1e3, field, dir, "rod")
+                }),
+        };
+        match meshed {
+            Ok(m) => Some(m),
+            Err(e) => {
+                eprintln!(
+                    "{}: mesh {}: the gmsh session stopped ({}); this mesh and the rest in fresh processes",
+                    self.label,
+                    ask.iteration,
+                    e.to_string().lines().next().unwrap_or_default()
+                );
+                self.session = None;
+                self.session_wanted = false;
+                None
+            }
+        }
     }
 
     /// Whether the meshes are made from the exact geometry (a STEP file).
@@ -153,30 +203,46 @@ impl Mesher for GmshRodMesher {
         let field_path = dir.join("size_field.bin");
         let mut scale = 1.0;
         let mut tries = 0;
-        let meshed = loop {
+        let served = if self.session_wanted {
             let field = match ask.size_map {
                 Some((m, s)) => {
-                    let scaled: Vec<f64> = s.iter().map(|v| v * scale).collect();
-                    write_size_field(&field_path, m, &scaled, 1e3)?;
+                    write_size_field(&field_path, m, s, 1e3)?;
                     Some(field_path.as_path())
                 }
                 None => None,
             };
-            // the loop's meshes are read natively: no meshio conversion, no .rodmesh
-            match self.mesh_into_reading(ask.size_m * 1e3 * scale, field, &dir, true) {
-                Ok(m) => break m,
-                Err(e) if tries < 2 => {
-                    eprintln!(
-                        "{}: mesh {} failed, sizes × {:.2} next: {}",
-                        self.label,
-                        ask.iteration,
-                        0.8 * scale,
-                        e.to_string().lines().last().unwrap_or_default()
-                    );
-                    scale *= 0.8;
-                    tries += 1;
+            self.mesh_in_session(ask, field, &dir)
+        } else {
+            None
+        };
+        let meshed = if let Some(m) = served {
+            m
+        } else {
+            loop {
+                let field = match ask.size_map {
+                    Some((m, s)) => {
+                        let scaled: Vec<f64> = s.iter().map(|v| v * scale).collect();
+                        write_size_field(&field_path, m, &scaled, 1e3)?;
+                        Some(field_path.as_path())
+                    }
+                    None => None,
+                };
+                // the loop's meshes are read natively: no meshio conversion, no .rodmesh
+                match self.mesh_into_reading(ask.size_m * 1e3 * scale, field, &dir, true) {
+                    Ok(m) => break m,
+                    Err(e) if tries < 2 => {
+                        eprintln!(
+                            "{}: mesh {} failed, sizes × {:.2} next: {}",
+                            self.label,
+                            ask.iteration,
+                            0.8 * scale,
+                            e.to_string().lines().last().unwrap_or_default()
+                        );
+                        scale *= 0.8;
+                        tries += 1;
+                    }
+                    Err(e) => return Err(e),
                 }
-                Err(e) => return Err(e),
             }
         };
         let secs = meshed.report.seconds_wall.max(meshed.report.seconds_total);

@@ -1,0 +1,126 @@
+//! The adaptive loop's gmsh session (`pipeline/mesh_rod.py serve`, [`GmshSession`]) against
+//! meshes made in fresh processes (`mesh_rod.py mesh`): the same classified surface and the same
+//! meshes, file for file, for a uniform first mesh and two size-field meshes after it (each made
+//! on the model the session built ahead from the cached classification, under the previous
+//! mesh's options); a failed request ends the session with gmsh's reason. Needs the pipeline's Python environment (gmsh).
+
+use std::path::{Path, PathBuf};
+
+use rodstudy::mesher::gmsh_session::GmshSession;
+use rodstudy::mesher::size_field::write_size_field;
+use rodstudy::mesher::{MeshRequest, mesh_stl_with};
+
+fn python() -> PathBuf {
+    rodstudy::python_env::python().expect("the pipeline's Python environment")
+}
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn script() -> PathBuf {
+    root().join("pipeline/mesh_rod.py")
+}
+
+fn stl() -> PathBuf {
+    root().join("designs/design1.stl")
+}
+
+fn bytes(path: &Path) -> Vec<u8> {
+    std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+#[test]
+fn a_session_makes_the_meshes_of_fresh_processes_file_for_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let (served, fresh) = (dir.path().join("served"), dir.path().join("fresh"));
+    let mut session =
+        GmshSession::start(&python(), &script(), &stl(), &served.join("classified.msh")).unwrap();
+    std::fs::create_dir_all(&served).unwrap();
+    let first = session.mesh(8.0, None, &served.join("m0"), "rod").unwrap();
+    assert!(first.report.failed_attempts.is_empty() && first.report.fallback.is_none());
+    // a size map graded along the rod (2.5 mm at the crank end to 10 mm beyond 150 mm), from
+    // the first mesh as the loop makes one
+    let sizes: Vec<f64> = first
+        .mesh
+        .nodes()
+        .iter()
+        .map(|p| (2.5e-3 + 0.05 * p[0].abs()).min(10e-3))
+        .collect();
+    let field = dir.path().join("size_field.bin");
+    write_size_field(&field, &first.mesh, &sizes, 1e3).unwrap();
+    let second = session
+        .mesh(10.0, Some(&field), &served.join("m1"), "rod")
+        .unwrap();
+    assert!(second.report.size_mm == 10.0 && second.mesh.n_elements() > 0);
+    // and the other way round: fine at the piston end
+    let sizes: Vec<f64> = second
+        .mesh
+        .nodes()
+        .iter()
+        .map(|p| (10e-3 - 0.04 * p[0].abs()).max(3e-3))
+        .collect();
+    let field2 = dir.path().join("size_field2.bin");
+    write_size_field(&field2, &second.mesh, &sizes, 1e3).unwrap();
+    let third = session
+        .mesh(8.0, Some(&field2), &served.join("m2"), "rod")
+        .unwrap();
+
+    let geometry = fresh.join("classified.msh");
+    // the same meshes in fresh processes, each `mesh_rod.py mesh` with the classified-surface cache
+    let in_fresh_process = |size_mm, size_field, out: &str| {
+        let request = MeshRequest {
+            size_mm,
+            size_field,
+            geometry: Some(&geometry),
+            name: Some("rod"),
+            native_read: true,
+        };
+        mesh_stl_with(&python(), &script(), &stl(), &request, &fresh.join(out)).unwrap()
+    };
+    let a = in_fresh_process(8.0, None, "m0");
+    let b = in_fresh_process(10.0, Some(&field), "m1");
+    let c = in_fresh_process(8.0, Some(&field2), "m2");
+    assert_eq!(
+        bytes(&served.join("classified.msh")),
+        bytes(&geometry),
+        "the classified surface"
+    );
+    for (s, f) in [(&first, &a), (&second, &b), (&third, &c)] {
+        assert_eq!(s.report.elements, f.report.elements);
+        assert!(
+            bytes(&s.report.msh) == bytes(&f.report.msh),
+            "{} and {} differ",
+            s.report.msh.display(),
+            f.report.msh.display()
+        );
+    }
+    // the second mesh followed the field: finer than the first near the crank end
+    assert!(second.mesh.n_elements() > first.mesh.n_elements());
+}
+
+#[test]
+fn a_failed_request_ends_the_session_with_the_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut session = GmshSession::start(
+        &python(),
+        &script(),
+        &stl(),
+        &dir.path().join("classified.msh"),
+    )
+    .unwrap();
+    let missing = dir.path().join("no_such_field.bin");
+    let err = session
+        .mesh(10.0, Some(&missing), &dir.path().join("m0"), "rod")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("no such size field file") && err.contains("no_such_field.bin"),
+        "{err}"
+    );
+    let err = session
+        .mesh(8.0, None, &dir.path().join("m1"), "rod")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("the gmsh session has ended"), "{err}");
+}
