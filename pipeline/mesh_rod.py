@@ -64,12 +64,7 @@ Two commands, both ending with one line of JSON on standard output (progress goe
       location are rod-frame millimetres, as for an STL. No surface classification and no facet
       floor: the geometry is exact. An element that stays inverted after the optimiser (minimum
       scaled Jacobian <= 0) is refused with a message, never handed to the solver. Same outputs
-      and JSON as `mesh` (`curved` true, `classify_angle_deg` 0; `fixed_addresses` below).
-      Reproducible: the optimiser visits elements in the order of their addresses, so the command
-      re-executes itself inside OUT_DIR, on fixed names (the STEP and the size field linked there
-      as input.step and input_size_field.bin), with address-space randomisation off and Python's
-      hashing fixed (`relaunched_fixed`); the same STEP, frame and sizes then give the same file in
-      any folder. JSON `fixed_addresses` says whether that was possible (Linux only).
+      and JSON as `mesh` (`curved` true, `classify_angle_deg` 0).
 
   mesh_rod.py serve STL --geometry FILE
       One gmsh session for a whole adaptive sequence of meshes of one STL (rodstudy's stage 3): one
@@ -152,9 +147,6 @@ LOCAL_MIN_SIZE_MM = 0.1
 # What to try when nothing works (the last line of a total failure).
 WHAT_TO_TRY = ("try: an STL exported at a different chord tolerance (finer or coarser), a STEP export of "
                "the part (meshed on the exact geometry), another --size, or a volume mesh of your own (--mesh)")
-
-# gmsh's high-order optimiser for the curved meshes of a STEP (`Mesh.HighOrderOptimize`).
-HIGH_ORDER_OPTIMIZE = 2
 
 # Smallest acceptable signed inverse condition number of an element (a sliver makes K
 # ill-conditioned: the reactions stop balancing the load to 1e-6).
@@ -977,7 +969,7 @@ def gmsh_step_mesh(step: pathlib.Path, frame: list, scale: float, size_mm: float
     try:
         for k, v in gmsh_options(size_mm, True, size_field is not None).items():
             gmsh.option.setNumber(k, v)
-        gmsh.option.setNumber("Mesh.HighOrderOptimize", HIGH_ORDER_OPTIMIZE)
+        gmsh.option.setNumber("Mesh.HighOrderOptimize", 2)
         gmsh.option.setNumber("Geometry.OCCScaling", 1.0)
         gmsh.option.setString("Geometry.OCCTargetUnit", "MM")
         if delaunay:
@@ -1019,49 +1011,6 @@ def gmsh_step_mesh(step: pathlib.Path, frame: list, scale: float, size_mm: float
         gmsh.finalize()
 
 
-# Linux `personality` flag: no address-space layout randomisation for the next exec
-ADDR_NO_RANDOMIZE = 0x0040000
-# Set in the environment of a `mesh-step` that runs with fixed addresses (see `relaunched_fixed`).
-FIXED_ADDRESSES_VAR = "RODSTUDY_FIXED_ADDRESSES"
-
-
-def relaunched_fixed(out_dir: pathlib.Path, argv: list[str]) -> None:
-    """Re-executes this command as `argv` inside `out_dir`, with address-space layout
-    randomisation off (Linux `personality(ADDR_NO_RANDOMIZE)`, what `setarch -R` does) and
-    Python's string hashing fixed; returns only where the system refuses (the meshes are then
-    valid but may differ between runs).
-
-    gmsh's high-order optimiser (`Mesh.HighOrderOptimize`, which makes a STEP's curved elements
-    valid) visits elements in the order of their addresses: with randomised addresses the same
-    STEP and size gave another mesh on every run (one foreign rod's judged peak 922-932 MPa over
-    four runs). Fixed addresses alone still depend on the lengths of the paths the process reads
-    (they shift the heap), so the command runs from the output folder on fixed relative names:
-    the same STEP, frame and sizes give the same mesh in any folder (`tests/step_input.rs`)."""
-    if not sys.platform.startswith("linux"):
-        return
-    try:
-        import ctypes
-
-        libc = ctypes.CDLL(None, use_errno=True)
-        current = libc.personality(0xFFFFFFFF)
-        if current == -1 or libc.personality(current | ADDR_NO_RANDOMIZE) == -1:
-            return
-    except (OSError, AttributeError):
-        return
-    env = dict(os.environ, PYTHONHASHSEED="0", **{FIXED_ADDRESSES_VAR: "1"})
-    os.chdir(out_dir)
-    os.execve(sys.executable, [sys.executable, str(pathlib.Path(__file__).resolve()), *argv], env)
-
-
-def linked(name: str, target: pathlib.Path) -> str:
-    """`name` in the current folder as a symbolic link to `target` (replaced if it exists)."""
-    link = pathlib.Path(name)
-    if link.is_symlink() or link.exists():
-        link.unlink()
-    link.symlink_to(target)
-    return name
-
-
 def cmd_mesh_step(args) -> dict:
     step = pathlib.Path(args.step)
     if not step.is_file():
@@ -1073,28 +1022,10 @@ def cmd_mesh_step(args) -> dict:
     out_dir = pathlib.Path(args.out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     name = args.name or step.stem
-    if args.size_field and not pathlib.Path(args.size_field).is_file():
-        raise SystemExit(f"mesh_rod: no such size field file: {args.size_field}")
-    if os.environ.get(FIXED_ADDRESSES_VAR) != "1":
-        # the same command inside OUT_DIR on fixed names: the STEP and the size field linked there
-        here = pathlib.Path.cwd()
-        os.chdir(out_dir)
-        try:
-            argv = ["mesh-step", linked("input.step", step.resolve()), ".", "--name", name,
-                    # one argument: a frame that starts with "-" would read as an option
-                    "--frame=" + ",".join(repr(v) for v in args.frame), "--scale", repr(args.scale),
-                    "--size", repr(args.size)]
-            if args.size_field:
-                argv += ["--size-field", linked("input_size_field.bin", (here / args.size_field).resolve())]
-            if args.no_rodmesh:
-                argv.append("--no-rodmesh")
-        finally:
-            os.chdir(here)
-        relaunched_fixed(out_dir, argv)
     msh, rodmesh = out_dir / f"{name}.msh", out_dir / f"{name}.rodmesh"
     size_field = pathlib.Path(args.size_field) if args.size_field else None
     t0 = time.perf_counter()
-    log(f"{step.resolve().name}: curved tet10 at {args.size} mm on the exact geometry" + (", size field" if size_field else ""))
+    log(f"{step.name}: curved tet10 at {args.size} mm on the exact geometry" + (", size field" if size_field else ""))
     failed = []
     info = None
     for delaunay in (False, True):
@@ -1105,14 +1036,11 @@ def cmd_mesh_step(args) -> dict:
             failed.append({"algorithm_3d": "delaunay" if delaunay else "hxt", "error": str(e)})
             log(f"  failed: {e}")
     if info is None:
-        raise SystemExit(f"mesh_rod: gmsh could not mesh {step.resolve()} at {args.size} mm: "
+        raise SystemExit(f"mesh_rod: gmsh could not mesh {step} at {args.size} mm: "
                          + "; ".join(f["error"] for f in failed))
-    info.update({"stl": str(step.resolve()), "msh": str(msh.resolve()), "size_mm": args.size, "curved": True,
-                 "classify_angle_deg": 0.0, "curve_angle_deg": 0.0, "failed_attempts": failed,
-                 "fixed_addresses": os.environ.get(FIXED_ADDRESSES_VAR) == "1"})
+    info.update({"stl": str(step), "msh": str(msh), "size_mm": args.size, "curved": True,
+                 "classify_angle_deg": 0.0, "curve_angle_deg": 0.0, "failed_attempts": failed})
     info.update(handed_off(msh, rodmesh, info, args.no_rodmesh))
-    if info.get("rodmesh"):
-        info["rodmesh"] = str(pathlib.Path(info["rodmesh"]).resolve())
     info["seconds_total"] = time.perf_counter() - t0
     log(f"{info['elements']} curved tet10, {info['nodes']} nodes, min SJ {info['min_scaled_jacobian']:.3f}, "
         f"{info['seconds_total']:.1f} s")

@@ -177,19 +177,6 @@ gmsh.finalize()
     assert!(e.contains("junk.step"), "{e}");
 }
 
-/// The STEP of the fillet test rod (`pipeline/fillet_rod.py step`), written into `dir`.
-fn fillet_rod_step(dir: &Path) -> std::path::PathBuf {
-    let step = dir.join("fillet_rod.step");
-    let o = Command::new(python().unwrap())
-        .arg(pipeline_script("fillet_rod.py"))
-        .arg("step")
-        .arg(&step)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    step
-}
-
 fn run_foreign_rods(out: &Path) -> serde_json::Value {
     let o = Command::new(python().unwrap())
         .arg(pipeline_script("foreign_rods.py"))
@@ -366,7 +353,14 @@ fn foreign_rods_through_the_study() {
 #[test]
 fn curved_tet10_on_the_step_fillet_rod() {
     let dir = tempfile::tempdir().unwrap();
-    let step = fillet_rod_step(dir.path());
+    let step = dir.path().join("fillet_rod.step");
+    let o = Command::new(python().unwrap())
+        .arg(pipeline_script("fillet_rod.py"))
+        .arg("step")
+        .arg(&step)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let data: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(
             rodstudy::python_env::project_root().join("tests/data/fillet_rod_reference.json"),
@@ -568,47 +562,4 @@ fn a_small_fillet_cut_into_45_degree_facets_is_refined_not_excluded() {
         "{:?}",
         plain.fem.warnings
     );
-}
-
-/// A STEP's curved mesh is the same file run after run and in any output folder: gmsh's
-/// high-order optimiser visits elements in the order of their addresses, so `mesh-step` runs with
-/// address-space randomisation off, from the output folder on fixed names (`relaunched_fixed` in
-/// `pipeline/mesh_rod.py`). Before, the fillet rod's mesh moved its nodes on every run.
-#[test]
-fn a_step_meshes_the_same_run_after_run_in_any_folder() {
-    use rodstudy::mesher::{MeshRequest, StepInRodFrame, mesh_step_with};
-    let dir = tempfile::tempdir().unwrap();
-    let step = fillet_rod_step(dir.path());
-    let in_rod_frame = StepInRodFrame {
-        step,
-        origin: [0.0; 3],
-        axes: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
-        scale: 1.0,
-    };
-    // at 4 mm the optimiser's order shows: two runs with random addresses differed in every
-    // pair tried (three of three); at 6 and 3 mm they happened to agree
-    let request = MeshRequest {
-        size_mm: 4.0,
-        name: Some("rod"),
-        native_read: true,
-        ..MeshRequest::default()
-    };
-    let mesh_in = |folder: &Path| {
-        let m = mesh_step_with(
-            &python().unwrap(),
-            &pipeline_script("mesh_rod.py"),
-            &in_rod_frame,
-            &request,
-            folder,
-        )
-        .unwrap();
-        assert!(m.report.curved && m.report.min_scaled_jacobian > 0.0);
-        assert_eq!(m.report.msh, folder.join("rod.msh"));
-        std::fs::read(&m.report.msh).unwrap()
-    };
-    let a = mesh_in(&dir.path().join("a"));
-    let b = mesh_in(&dir.path().join("a longer folder name").join("and deeper"));
-    let c = mesh_in(&dir.path().join("a"));
-    assert!(a == b, "another folder, another mesh");
-    assert!(a == c, "another run, another mesh");
 }
