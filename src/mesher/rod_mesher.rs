@@ -94,14 +94,15 @@ impl GmshRodMesher {
         if !self.session_wanted {
             return None;
         }
-        let meshed = match &mut self.session {
-            Some(session) => session.mesh(ask.size_m * 1e3, field, dir, "rod"),
-            None => GmshSession::start(&self.python, &self.script, &self.stl, &self.geometry)
-                .and_then(|session| {
-                    let session = self.session.insert(session);
-                    session.mesh(ask.size_m * 1e3, field, dir, "rod")
-                }),
+        let session = match self.session.take() {
+            Some(session) => Ok(session),
+            None => GmshSession::start(&self.python, &self.script, &self.stl, &self.geometry),
         };
+        let meshed = session.and_then(|session| {
+            self.session
+                .insert(session)
+                .mesh(ask.size_m * 1e3, field, dir, "rod")
+        });
         match meshed {
             Ok(m) => Some(m),
             Err(e) => {
