@@ -140,6 +140,44 @@ fn long_free_run_finishes_under_the_default_cap() {
     assert!(msg.contains("step limit of 1000000 steps"), "{msg}");
 }
 
+/// Issue 21 item 1: `dynamics free --project-energy` reports its projections in the JSON
+/// (`energy_projection`), agrees with the exact reference, and is refused with another method.
+#[test]
+fn free_run_with_the_energy_projection() {
+    let o = rodstudy(
+        &[
+            "dynamics",
+            "free",
+            "--method",
+            "rk45",
+            "--atol",
+            "1e-10",
+            "--project-energy",
+            "--json",
+        ],
+        &[],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let p = &v["energy_projection"];
+    assert!(
+        p["projections"].as_u64().unwrap() >= v["steps"].as_u64().unwrap(),
+        "{v}"
+    );
+    assert!(p["max_change_rad_s"].as_f64().unwrap() < 1e-6, "{v}");
+    assert!(v["max_err_phi_rad"].as_f64().unwrap() < 1e-9, "{v}");
+    let plain = rodstudy(&["dynamics", "free", "--json"], &[]);
+    let v: serde_json::Value = serde_json::from_slice(&plain.stdout).unwrap();
+    assert!(v.get("energy_projection").is_none(), "{v}");
+    let bdf = rodstudy(
+        &["dynamics", "free", "--method", "bdf", "--project-energy"],
+        &[],
+    );
+    assert!(!bdf.status.success());
+    let msg = String::from_utf8_lossy(&bdf.stderr);
+    assert!(msg.contains("rk45 only"), "{msg}");
+}
+
 /// Issue 13 item 1: `rodstudy mass` gives the mass properties of any closed solid; without bores
 /// at the pins the mechanism-frame fields are null with a warning, and the study still refuses it.
 #[test]

@@ -99,6 +99,10 @@ pub struct FreeArgs {
     /// Write t, φ, ω on the 1e-4 s output grid to this CSV file.
     #[arg(long)]
     csv: Option<PathBuf>,
+    /// rk45 only: after every step put φ̇ back onto the energy integral at the step's φ
+    /// (projection onto the invariant; removes the method's energy drift over long runs).
+    #[arg(long)]
+    project_energy: bool,
 }
 
 /// What `dynamics free --json` prints: the run without its trajectories, and its error against
@@ -117,11 +121,21 @@ struct FreeSummary<'a> {
     lu_decompositions: u64,
     cpu_s: f64,
     energy_drift_max_j: Option<f64>,
+    /// With `--project-energy`: the projections made and the largest change of φ̇ [rad/s].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    energy_projection: Option<ProjectionSummary>,
     /// The DAE forms' largest constraint violation (max |Φ|, max |D ċ|) over the run.
     constraint_drift_max: Option<crate::mechanism::forward::ConstraintViolation>,
     max_err_phi_rad: Option<f64>,
     max_err_omega_rad_s: Option<f64>,
     warnings: &'a [String],
+}
+
+/// `energy_projection` of [`FreeSummary`].
+#[derive(serde::Serialize)]
+struct ProjectionSummary {
+    projections: u64,
+    max_change_rad_s: f64,
 }
 
 fn free(args: FreeArgs) -> Result<i32> {
@@ -136,6 +150,7 @@ fn free(args: FreeArgs) -> Result<i32> {
     // the default caps grow with the simulated time; an explicit --max-steps is a total
     options = options.with_caps_for_duration();
     options.max_steps = args.max_steps.unwrap_or(options.max_steps);
+    options.project_energy = args.project_energy;
     let mut run = run_free(method, &options).map_err(|e| anyhow::anyhow!("{method}: {e}"))?;
     // the exact reference where the scene has one; warns when the error exceeds 10× the
     // tolerance
@@ -157,6 +172,10 @@ fn free(args: FreeArgs) -> Result<i32> {
         lu_decompositions: run.lu_decompositions,
         cpu_s: run.cpu_s,
         energy_drift_max_j: run.energy_drift_max_j,
+        energy_projection: options.project_energy.then_some(ProjectionSummary {
+            projections: run.energy_projections,
+            max_change_rad_s: run.energy_projection_max_change_rad_s,
+        }),
         constraint_drift_max: run.constraint_drift_max,
         max_err_phi_rad: errors.map(|e| e.0),
         max_err_omega_rad_s: errors.map(|e| e.1),
@@ -186,6 +205,12 @@ fn free(args: FreeArgs) -> Result<i32> {
         }
         if let Some(e) = summary.energy_drift_max_j {
             println!("energy drift: {e:.3e} J");
+        }
+        if let Some(p) = &summary.energy_projection {
+            println!(
+                "energy projection: {} projections, largest change of φ̇ {:.3e} rad/s",
+                p.projections, p.max_change_rad_s
+            );
         }
         if let Some(c) = &summary.constraint_drift_max {
             println!(

@@ -21,6 +21,7 @@
 //! [`ENERGY_WARN_REL`] of the kinetic energy.
 
 pub mod dae;
+mod energy_projection;
 mod loads;
 mod mechanism;
 mod method;
@@ -33,6 +34,7 @@ mod run;
 mod scene;
 mod sweep;
 
+pub use energy_projection::EnergyProjection;
 pub use loads::{G, GasSpring, Loads};
 pub use mechanism::{CrankSliderData, KinematicPoint, Kinematics};
 pub use method::{Method, UnknownMethod};

@@ -95,7 +95,7 @@ impl ExactReference {
 }
 
 /// `W(Δ)` and `φ̇(Δ)` relative to the start `(φ0, φ̇0)`.
-struct EnergyIntegral<'a> {
+pub(super) struct EnergyIntegral<'a> {
     model: &'a ReducedModel,
     loads: Loads,
     phi0: f64,
@@ -106,7 +106,26 @@ struct EnergyIntegral<'a> {
     evals: u64,
 }
 
-impl EnergyIntegral<'_> {
+impl<'a> EnergyIntegral<'a> {
+    /// The integral of `loads` (conservative: the caller checks) on `model` from `(φ0, φ̇0)`.
+    pub(super) fn new(model: &'a ReducedModel, loads: &Loads, phi0: f64, omega0: f64) -> Self {
+        EnergyIntegral {
+            model,
+            loads: *loads,
+            phi0,
+            omega0,
+            i0: model.i_red(phi0),
+            x0: model.kinematics().x(phi0),
+            g_start: 0.0,
+            evals: 0,
+        }
+    }
+
+    /// The start angle `φ0` \[rad\].
+    pub(super) fn phi0(&self) -> f64 {
+        self.phi0
+    }
+
     /// Work of the loads plus initial kinetic energy, `W(φ0 + Δ)` (cancellation-free).
     fn work(&self, delta: f64) -> f64 {
         let kin = self.model.kinematics();
@@ -126,7 +145,7 @@ impl EnergyIntegral<'_> {
     }
 
     /// `φ̇(φ0 + Δ)`; `None` if `W ≤ 0` (the crank would have stopped).
-    fn omega(&self, delta: f64) -> Option<f64> {
+    pub(super) fn omega(&self, delta: f64) -> Option<f64> {
         let w = self.work(delta);
         if w.is_nan() || w <= 0.0 {
             return None;
@@ -242,14 +261,8 @@ pub fn exact_reference_with_tol(
         2.0 * (i0 / (2.0 * m_red0)).sqrt()
     };
     let mut ei = EnergyIntegral {
-        model,
-        loads: *loads,
-        phi0,
-        omega0,
-        i0,
-        x0: model.kinematics().x(phi0),
         g_start,
-        evals: 0,
+        ..EnergyIntegral::new(model, loads, phi0, omega0)
     };
     let span = grid.t_end() - grid.t0;
 

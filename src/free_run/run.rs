@@ -2,11 +2,12 @@
 
 use super::FreeRunError;
 use super::dae::{self, ConstraintViolation, DaeOptions};
+use super::energy_projection::EnergyProjection;
 use super::method::Method;
 use super::ode::CrankOde;
 use super::reference::ExactReference;
 use super::scene::FreeScene;
-use crate::integrators::{JacobianSource, SolverOptions, TOL_FLOOR_KAPPA, solve};
+use crate::integrators::{JacobianSource, SolverOptions, TOL_FLOOR_KAPPA, rk45, solve};
 use nalgebra::DVector;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
@@ -42,6 +43,10 @@ pub struct FreeRunOptions {
     /// Settings of the multibody DAE forms (stabilisation, ρ∞, Newton).
     #[serde(default)]
     pub dae: DaeOptions,
+    /// RK45 on the reduced model only: after every step φ̇ is put back onto the energy
+    /// integral at the step's φ ([`EnergyProjection`]; conservative loads).
+    #[serde(default)]
+    pub project_energy: bool,
 }
 
 impl Default for FreeRunOptions {
@@ -57,6 +62,7 @@ impl Default for FreeRunOptions {
             max_rhs_evals: 10_000_000,
             jacobian: JacobianSource::Auto,
             dae: DaeOptions::default(),
+            project_energy: false,
         }
     }
 }
@@ -104,6 +110,10 @@ pub struct FreeRunResult {
     pub method: Method,
     /// Model used (the cheapest that answers the scene exactly).
     pub model: &'static str,
+    /// Projections onto the energy integral made (`project_energy`; else 0).
+    pub energy_projections: u64,
+    /// The largest change of φ̇ one of them made [rad/s].
+    pub energy_projection_max_change_rad_s: f64,
     /// Crank angle at `t_end` \[rad\].
     pub phi_rad: f64,
     /// Crank angular velocity at `t_end` [rad/s].
@@ -229,6 +239,25 @@ pub fn run_free(method: Method, options: &FreeRunOptions) -> Result<FreeRunResul
     let scene = &options.scene;
     let model = scene.model()?;
     let grid = scene.grid()?;
+    if options.project_energy && method != Method::Rk45 {
+        return Err(FreeRunError::Options(format!(
+            "the energy projection runs with rk45 only, not with {method}"
+        )));
+    }
+    let mut projection = if options.project_energy {
+        let p = EnergyProjection::new(&model, &scene.loads, scene.phi0, scene.omega0).ok_or_else(
+            || {
+                FreeRunError::Options(
+                    "the energy projection needs conservative loads (no damping): there is no \
+                     energy integral to project on"
+                        .into(),
+                )
+            },
+        )?;
+        Some(p)
+    } else {
+        None
+    };
     let run = match method.ode_method() {
         Some(ode_method) => {
             let sys = CrankOde {
@@ -238,7 +267,10 @@ pub fn run_free(method: Method, options: &FreeRunOptions) -> Result<FreeRunResul
             let y0 = DVector::from_vec(vec![scene.phi0, scene.omega0]);
             let opts = options.solver_options(method);
             let start = Instant::now();
-            let sol = solve(ode_method, &sys, &y0, &grid, &opts)?;
+            let sol = match projection.as_mut() {
+                Some(p) => rk45::solve_projected(&sys, &y0, &grid, &opts, p)?,
+                None => solve(ode_method, &sys, &y0, &grid, &opts)?,
+            };
             let cpu_s = start.elapsed().as_secs_f64();
             dae::DaeRun {
                 phi: sol.component(0),
@@ -291,6 +323,8 @@ pub fn run_free(method: Method, options: &FreeRunOptions) -> Result<FreeRunResul
     Ok(FreeRunResult {
         method,
         model: run.model,
+        energy_projections: projection.as_ref().map_or(0, |p| p.projections),
+        energy_projection_max_change_rad_s: projection.as_ref().map_or(0.0, |p| p.max_change_rad_s),
         phi_rad: *phi.last().unwrap_or(&f64::NAN),
         omega_rad_s: *omega.last().unwrap_or(&f64::NAN),
         steps: run.stats.steps,

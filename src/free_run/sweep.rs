@@ -223,6 +223,7 @@ pub fn work_precision_sweep(
                 max_rhs_evals: cfg.max_rhs_evals,
                 jacobian: cfg.jacobian,
                 dae: cfg.dae,
+                project_energy: false,
             };
             let mut times = Vec::with_capacity(cfg.repeats.max(1));
             let mut last = None;

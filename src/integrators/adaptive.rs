@@ -187,9 +187,9 @@ pub(crate) fn integrate<M: AdaptiveStepper, S: OdeSystem + ?Sized>(
             .map_err(|m| ev.fail(FailureKind::Projection(m)))?;
     }
     let mut rec = Recorder::new(grid, &y);
-    // periodic components as whole periods + remainder (turns.rs; not with a projection,
-    // which works on the full state)
-    let mut turns = Turns::new(sys, n, proj.is_none());
+    // periodic components as whole periods + remainder (turns.rs); a projection sees the full
+    // state and its change is added to the remainder ([`write_back_projection`])
+    let mut turns = Turns::new(sys, n);
     let mut comp = DVector::zeros(n);
     let mut y_full = DVector::zeros(n);
     if turns.wrap(&mut y, &mut comp) {
@@ -252,15 +252,17 @@ pub(crate) fn integrate<M: AdaptiveStepper, S: OdeSystem + ?Sized>(
             ev.stats.floored_steps += 1;
         }
         compensated_add(&y, &dy, &mut comp, &mut y_new);
+        if turns.any() {
+            turns.full(&y_new, &mut y_full);
+        }
         if let Some(p) = proj.as_deref_mut() {
-            y_proj.copy_from(&y_new);
+            y_proj.copy_from(if turns.any() { &y_full } else { &y_new });
             p.project(t_new, &mut y_proj)
                 .map_err(|m| ev.fail(FailureKind::Projection(m)))?;
         }
         let y_out = if proj.is_some() {
             &y_proj
         } else if turns.any() {
-            turns.full(&y_new, &mut y_full);
             &y_full
         } else {
             &y_new
@@ -283,6 +285,9 @@ pub(crate) fn integrate<M: AdaptiveStepper, S: OdeSystem + ?Sized>(
         if last {
             break;
         }
+        if proj.is_some() {
+            write_back_projection(&turns, &y_proj, &y_full, &mut y_new, &mut comp);
+        }
         let fac_max = if rejected { 1.0 } else { FAC_MAX };
         h = (h_step * stepper.accept_factor(err, fac_max)).min(h_max);
         t = t_new;
@@ -293,12 +298,42 @@ pub(crate) fn integrate<M: AdaptiveStepper, S: OdeSystem + ?Sized>(
         stepper.accept();
         if proj.is_some() {
             // the FSAL stage belongs to the unprojected ỹ_{n+1}: re-evaluate at y_{n+1}
-            y.copy_from(&y_proj);
-            comp.fill(0.0);
             ev.rhs_finite(t, &y, stepper.derivative_mut())?;
         }
     }
     Ok(rec.finish(ev.stats))
+}
+
+/// The projected state `y_proj` of a step into the solver's own state `y_new` (with its
+/// compensation `comp`). Without periodic components `y_new` becomes `y_proj` and the
+/// compensation is dropped (the projection's value is the state). With them, `y_proj` was
+/// projected from the full state `y_full` (whole periods + remainder, rounded to the ulp of the
+/// full value): a periodic component the projection left unchanged keeps its exact remainder
+/// and compensation, a changed one gets the change added to its remainder; a non-periodic
+/// component takes the projected value.
+fn write_back_projection(
+    turns: &Turns,
+    y_proj: &DVector<f64>,
+    y_full: &DVector<f64>,
+    y_new: &mut DVector<f64>,
+    comp: &mut DVector<f64>,
+) {
+    if !turns.any() {
+        y_new.copy_from(y_proj);
+        comp.fill(0.0);
+        return;
+    }
+    for i in 0..y_new.len() {
+        if y_proj[i] == y_full[i] {
+            continue;
+        }
+        if turns.is_periodic(i) {
+            y_new[i] += y_proj[i] - y_full[i];
+        } else {
+            y_new[i] = y_proj[i];
+        }
+        comp[i] = 0.0;
+    }
 }
 
 /// `y_new + comp ← y + (dy + comp)` componentwise by Knuth's two-sum (exact: `y_new` is the

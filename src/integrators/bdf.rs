@@ -156,7 +156,7 @@ pub fn solve<S: OdeSystem + ?Sized>(
     let mut comp = DVector::zeros(n);
     let mut y_n = DVector::zeros(n);
     // periodic components as whole periods + remainder (turns.rs)
-    let mut turns = Turns::new(sys, n, true);
+    let mut turns = Turns::new(sys, n);
     let mut y_full = DVector::zeros(n);
     if turns.wrap(&mut d[0], &mut comp) {
         weights.set_offset(turns.offset());

@@ -17,7 +17,10 @@
 //! `ỹ_{n+1}`) is evaluated at each interior output time and the sample is projected with the
 //! same map `P`; a grid point at `t_{n+1}` takes `y_{n+1}`. The samples therefore lie on the
 //! manifold, and differ from the unprojected interpolant by O(local error), which keeps its
-//! 4th order.
+//! 4th order. A periodic component ([`OdeSystem::period`](super::OdeSystem::period)) stays
+//! whole periods + remainder under a projection: the projection sees the full state, and a
+//! change it makes is added to the remainder (the free crank's energy projection changes φ̇
+//! only, so φ keeps its exact remainder and compensation).
 
 use super::adaptive::{AdaptiveStepper, Attempt, Step, integrate};
 use super::control::Controller;

@@ -30,14 +30,10 @@ pub(crate) struct Turns {
 }
 
 impl Turns {
-    /// The periods of `sys` (none when `enabled` is false, e.g. with a projection that works
-    /// on the full state).
-    pub(crate) fn new<S: OdeSystem + ?Sized>(sys: &S, n: usize, enabled: bool) -> Self {
+    /// The periods of `sys`.
+    pub(crate) fn new<S: OdeSystem + ?Sized>(sys: &S, n: usize) -> Self {
         let period = (0..n)
-            .map(|i| {
-                sys.period(i)
-                    .filter(|p| enabled && p.is_finite() && *p > 0.0)
-            })
+            .map(|i| sys.period(i).filter(|p| p.is_finite() && *p > 0.0))
             .collect();
         Self {
             period,
@@ -49,6 +45,11 @@ impl Turns {
     /// `true` if any component is periodic.
     pub(crate) fn any(&self) -> bool {
         self.period.iter().any(Option::is_some)
+    }
+
+    /// `true` if component `i` is carried as whole periods + a remainder.
+    pub(crate) fn is_periodic(&self, i: usize) -> bool {
+        self.period[i].is_some()
     }
 
     /// `turns_i · P_i` per component.
