@@ -241,7 +241,8 @@ pub fn run_free(method: Method, options: &FreeRunOptions) -> Result<FreeRunResul
     let grid = scene.grid()?;
     if options.project_energy && method != Method::Rk45 {
         return Err(FreeRunError::Options(format!(
-            "the energy projection runs with rk45 only, not with {method}"
+            "the energy projection runs with rk45 only, not with {method}: use --method rk45 \
+             with --project-energy, or drop --project-energy"
         )));
     }
     let mut projection = if options.project_energy {
@@ -249,7 +250,7 @@ pub fn run_free(method: Method, options: &FreeRunOptions) -> Result<FreeRunResul
             || {
                 FreeRunError::Options(
                     "the energy projection needs conservative loads (no damping): there is no \
-                     energy integral to project on"
+                     energy integral to project on; drop --project-energy for a damped scene"
                         .into(),
                 )
             },
