@@ -73,6 +73,46 @@ fn reference_is_self_consistent() {
     }
 }
 
+/// The long-horizon table's projected rows (`integrators --t-end 100`): RK45 with the energy
+/// projection is run after the plain methods, labelled, kept out of the plain method's rows, and
+/// far closer to the exact reference than plain RK45 at the same tolerance (at 100 s 1,800×,
+/// docs/free-run.md; over 10 s measured here).
+#[test]
+fn the_sweep_runs_rk45_with_the_energy_projection_as_its_own_rows() {
+    let scene = FreeScene::long_run(10.0, 1e-3);
+    let cfg = SweepConfig {
+        repeats: 1,
+        methods: vec![Method::Rk45],
+        tolerances: vec![1e-7, 1e-8, 1e-9],
+        projected_methods: vec![Method::Rk45],
+        ..SweepConfig::default()
+    };
+    let wp = work_precision_sweep(&scene, &cfg).unwrap();
+    assert_eq!(wp.rows.len(), 6);
+    let plain = wp.rows_of(Method::Rk45);
+    let projected = wp.rows_of_variant(Method::Rk45, true);
+    assert_eq!((plain.len(), projected.len()), (3, 3));
+    assert!(plain.iter().all(|r| !r.project_energy));
+    assert!(wp.is_monotone_variant(Method::Rk45, true));
+    for (p, q) in plain.iter().zip(&projected) {
+        assert_eq!(p.value, q.value);
+        let (ep, eq) = (p.max_err_phi_rad.unwrap(), q.max_err_phi_rad.unwrap());
+        assert!(
+            eq * 10.0 < ep,
+            "atol {:e}: projected {eq:e}, plain {ep:e}",
+            p.value
+        );
+        // one evaluation more per step (the projected state's first stage)
+        assert!(q.rhs_evals > p.rhs_evals);
+    }
+    let md = wp.to_markdown();
+    assert_eq!(
+        md.matches("| rk45 + energy projection |").count(),
+        3,
+        "{md}"
+    );
+}
+
 #[test]
 fn work_precision_sweep_meets_targets() {
     let scene = FreeScene::thesis();

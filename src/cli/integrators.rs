@@ -22,7 +22,8 @@ pub struct IntegratorsArgs {
     #[arg(long, default_value_t = 5)]
     repeats: usize,
     /// End time [s]. Other than 1: the long-horizon table (scene `free` run to T, output
-    /// every 1e-4·T s, the reduced-model methods, tolerances 1e-6 … 1e-12, caps of 5e5 steps
+    /// every 1e-4·T s, the reduced-model methods and RK45 with the energy projection,
+    /// tolerances 1e-6 … 1e-12, caps of 5e5 steps
     /// and 5e6 evaluations per simulated second; a method's tighter tolerances are skipped
     /// once it reaches the cap), written to work_precision_<T>s.* beside the 1 s files.
     #[arg(long, default_value_t = 1.0)]
@@ -48,6 +49,7 @@ pub fn run(args: IntegratorsArgs) -> Result<i32> {
             repeats: args.repeats,
             max_steps: (5e5 * t.max(1.0)).ceil() as u64,
             max_rhs_evals: (5e6 * t.max(1.0)).ceil() as u64,
+            projected_methods: vec![Method::Rk45],
             ..SweepConfig::default()
         };
         (scene, config, format!("work_precision_{t}s"))
@@ -96,6 +98,13 @@ pub fn run(args: IntegratorsArgs) -> Result<i32> {
         .iter()
         .filter(|m| !wp.is_monotone(**m))
         .map(|m| m.to_string())
+        .chain(
+            config
+                .projected_methods
+                .iter()
+                .filter(|m| !wp.is_monotone_variant(**m, true))
+                .map(|m| format!("{m} + energy projection")),
+        )
         .collect();
     if !non_monotone.is_empty() {
         eprintln!(
@@ -110,6 +119,7 @@ pub fn run(args: IntegratorsArgs) -> Result<i32> {
 #[derive(serde::Serialize)]
 struct CsvRow {
     method: String,
+    project_energy: bool,
     setting: &'static str,
     value: f64,
     failure: Option<String>,
@@ -129,6 +139,7 @@ impl From<&crate::free_run::SweepRow> for CsvRow {
     fn from(r: &crate::free_run::SweepRow) -> Self {
         CsvRow {
             method: r.method.to_string(),
+            project_energy: r.project_energy,
             setting: r.setting,
             value: r.value,
             failure: r.failure.clone(),
@@ -146,18 +157,23 @@ impl From<&crate::free_run::SweepRow> for CsvRow {
     }
 }
 
-/// Max |Δφ| against `cost`, log–log, one line per method.
+/// Max |Δφ| against `cost`, log–log, one line per method (and per projected method).
 fn plot(
     wp: &WorkPrecision,
     cost_label: &str,
     cost: impl Fn(&crate::free_run::SweepRow) -> f64,
 ) -> Result<String> {
-    let series: Vec<Series> = Method::ALL
-        .iter()
-        .map(|m| Series {
-            name: m.to_string(),
+    let series: Vec<Series> = [false, true]
+        .into_iter()
+        .flat_map(|p| Method::ALL.iter().map(move |m| (*m, p)))
+        .map(|(m, projected)| Series {
+            name: if projected {
+                format!("{m} + energy projection")
+            } else {
+                m.to_string()
+            },
             points: wp
-                .rows_of(*m)
+                .rows_of_variant(m, projected)
                 .into_iter()
                 .filter_map(|r| r.max_err_phi_rad.map(|e| (cost(r), e)))
                 .collect(),

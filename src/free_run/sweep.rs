@@ -38,6 +38,10 @@ pub struct SweepConfig {
     pub max_rhs_evals: u64,
     /// Jacobian source of the implicit methods.
     pub jacobian: JacobianSource,
+    /// Methods run a second time with the energy projection (`--project-energy`, conservative
+    /// scenes, RK45 only), after the plain ones; empty by default.
+    #[serde(default)]
+    pub projected_methods: Vec<Method>,
 }
 
 impl Default for SweepConfig {
@@ -52,6 +56,7 @@ impl Default for SweepConfig {
             max_steps: 1_000_000,
             max_rhs_evals: 10_000_000,
             jacobian: JacobianSource::Auto,
+            projected_methods: Vec::new(),
         }
     }
 }
@@ -65,6 +70,8 @@ fn default_genalpha_steps() -> Vec<f64> {
 pub struct SweepRow {
     /// Method.
     pub method: Method,
+    /// Run with the energy projection (`dynamics free --project-energy`).
+    pub project_energy: bool,
     /// `"atol"` (adaptive, `rtol = 0`) or `"step"` (fixed step \[s\]).
     pub setting: &'static str,
     /// The tolerance or step.
@@ -109,16 +116,29 @@ pub struct WorkPrecision {
 }
 
 impl WorkPrecision {
-    /// The rows of one method.
+    /// The rows of one method run plainly.
     pub fn rows_of(&self, method: Method) -> Vec<&SweepRow> {
-        self.rows.iter().filter(|r| r.method == method).collect()
+        self.rows_of_variant(method, false)
     }
 
-    /// `true` if the method's successful runs have non-increasing φ and φ̇ errors as the
+    /// The rows of one method, run plainly (`projected` false) or with the energy projection.
+    pub fn rows_of_variant(&self, method: Method, projected: bool) -> Vec<&SweepRow> {
+        self.rows
+            .iter()
+            .filter(|r| r.method == method && r.project_energy == projected)
+            .collect()
+    }
+
+    /// `true` if the method's successful plain runs have non-increasing φ and φ̇ errors as the
     /// tolerance (or step) decreases.
     pub fn is_monotone(&self, method: Method) -> bool {
+        self.is_monotone_variant(method, false)
+    }
+
+    /// [`Self::is_monotone`] for the plain (`projected` false) or the projected runs.
+    pub fn is_monotone_variant(&self, method: Method, projected: bool) -> bool {
         let ok: Vec<_> = self
-            .rows_of(method)
+            .rows_of_variant(method, projected)
             .into_iter()
             .filter(|r| r.failure.is_none())
             .collect();
@@ -146,8 +166,13 @@ impl WorkPrecision {
             let fmt = |v: Option<f64>| v.map_or("–".to_string(), |x| format!("{x:.2e}"));
             let _ = writeln!(
                 s,
-                "| {} | {} = {:.0e} | {} | {} | {} | {} | {} | {}{} |",
+                "| {}{} | {} = {:.0e} | {} | {} | {} | {} | {} | {}{} |",
                 r.method,
+                if r.project_energy {
+                    " + energy projection"
+                } else {
+                    ""
+                },
                 r.setting,
                 r.value,
                 fmt(r.max_err_phi_rad),
@@ -181,7 +206,12 @@ pub fn work_precision_sweep(
     let reference = scene.reference()?;
     let reference_cpu_s = start.elapsed().as_secs_f64();
     let mut rows = Vec::new();
-    for &method in &cfg.methods {
+    let variants = cfg
+        .methods
+        .iter()
+        .map(|&m| (m, false))
+        .chain(cfg.projected_methods.iter().map(|&m| (m, true)));
+    for (method, project_energy) in variants {
         let (setting, values) = if method == Method::DaeGenAlpha {
             ("step", &cfg.genalpha_steps)
         } else if method.is_fixed_step() {
@@ -194,6 +224,7 @@ pub fn work_precision_sweep(
             if let Some(at) = capped {
                 rows.push(SweepRow {
                     method,
+                    project_energy,
                     setting,
                     value,
                     failure: Some(format!(
@@ -223,7 +254,7 @@ pub fn work_precision_sweep(
                 max_rhs_evals: cfg.max_rhs_evals,
                 jacobian: cfg.jacobian,
                 dae: cfg.dae,
-                project_energy: false,
+                project_energy,
             };
             let mut times = Vec::with_capacity(cfg.repeats.max(1));
             let mut last = None;
@@ -247,6 +278,7 @@ pub fn work_precision_sweep(
                     let (ep, ew) = r.check_against_reference(&reference, &opts);
                     SweepRow {
                         method,
+                        project_energy,
                         setting,
                         value,
                         failure: None,
@@ -268,6 +300,7 @@ pub fn work_precision_sweep(
                     }
                     SweepRow {
                         method,
+                        project_energy,
                         setting,
                         value,
                         failure: Some(e.to_string()),
