@@ -97,6 +97,42 @@ fn a_session_makes_the_meshes_of_fresh_processes_file_for_file() {
     }
     // the second mesh followed the field: finer than the first near the crank end
     assert!(second.mesh.n_elements() > first.mesh.n_elements());
+    // each mesh says where its time went: gmsh's phases from its log, within the mesher's own
+    // total, HXT's optimisation within the 3D mesh, and the read measured on this side
+    for m in [&first, &second, &third, &a, &b, &c] {
+        let p = m.report.phases_s.expect("the mesher's phases");
+        let parts = [
+            p.model,
+            p.mesh_1d,
+            p.mesh_2d,
+            p.mesh_3d,
+            p.order_2,
+            p.qualities,
+            p.write,
+        ];
+        assert!(
+            parts
+                .iter()
+                .chain([&p.hxt_optimise, &p.read])
+                .all(|x| x.is_some_and(|v| v >= 0.0)),
+            "{p:?}"
+        );
+        let sum: f64 = parts.iter().flatten().sum();
+        assert!(
+            sum <= m.report.seconds_total + 1e-3,
+            "{p:?} against {}",
+            m.report.seconds_total
+        );
+        assert!(p.hxt_optimise <= p.mesh_3d, "{p:?}");
+    }
+    // the classification is in the first mesh's model, not in a later one's
+    let model = |m: &rodstudy::mesher::MeshedRod| m.report.phases_s.unwrap().model.unwrap();
+    assert!(
+        model(&first) > 2.0 * model(&second),
+        "{} vs {}",
+        model(&first),
+        model(&second)
+    );
 }
 
 #[test]

@@ -4,7 +4,10 @@
 //! (`fx.adaptive[k].timings`, [`crate::fem::rod::StepTimings`]): the mesh (gmsh, with the STL's
 //! classification on the first), the analysis (assembly, symbolic analysis, factorisation, solves,
 //! stresses with recovery and error estimate) and the rest (sizing the next mesh). The shares are
-//! against the loop's own total, so they travel between machines better than the seconds.
+//! against the loop's own total, so they travel between machines better than the seconds. Where
+//! gmsh made the meshes, a third table splits each mesh into gmsh's own phases
+//! ([`MeshPhases`]: the model, 1D, 2D, 3D with HXT's optimisation, order 2) and the calls around
+//! them (qualities, write, and the read on this side).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -12,6 +15,8 @@ use std::time::Instant;
 
 use anyhow::{Result, bail};
 use serde::{Deserialize, Serialize};
+
+use crate::fem::rod::MeshPhases;
 
 /// One iteration of one design.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -30,6 +35,9 @@ pub struct IterationRow {
     pub seconds: f64,
     /// Estimated relative error of the F_x and F_y peaks after this iteration.
     pub estimated_error_rel: [f64; 2],
+    /// The mesh's own phases (gmsh's, and the read), where the mesher reported them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mesh_phases: Option<MeshPhases>,
 }
 
 /// One design's loop.
@@ -112,6 +120,7 @@ fn design_row(stl: &Path, v: &serde_json::Value, command_s: f64) -> Result<Desig
                     num(&x["estimated_error_rel"]),
                     num(&y["estimated_error_rel"]),
                 ],
+                mesh_phases: serde_json::from_value(t["mesh_phases"].clone()).ok(),
             }
         })
         .collect();
@@ -187,6 +196,43 @@ pub fn markdown(b: &AdaptiveBench) -> String {
             ),
         ));
     }
+    let phased: Vec<(&DesignRow, &IterationRow, &MeshPhases)> = b
+        .designs
+        .iter()
+        .flat_map(|d| {
+            d.iterations
+                .iter()
+                .filter_map(move |r| r.mesh_phases.as_ref().map(|p| (d, r, p)))
+        })
+        .collect();
+    if !phased.is_empty() {
+        s.push_str(
+            "\nThe meshes phase by phase [s] (gmsh's own wall times; `model`: the classification on \
+             the first mesh, the options alone where the gmsh session built the model while the \
+             last mesh was solved; HXT's optimisation is part of 3D; `read`: the mesh read back \
+             here)\n\n\
+             | design | iteration | mesh [s] | model | 1D | 2D | 3D | of it HXT optimisation | order 2 | qualities | write | read |\n\
+             |---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        );
+        let f = |x: Option<f64>| x.map_or("–".to_string(), |v| format!("{v:.2}"));
+        for (d, r, p) in phased {
+            s.push_str(&format!(
+                "| {} | {} | {:.2} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+                d.design,
+                r.iteration,
+                r.mesh_s,
+                f(p.model),
+                f(p.mesh_1d),
+                f(p.mesh_2d),
+                f(p.mesh_3d),
+                f(p.hxt_optimise),
+                f(p.order_2),
+                f(p.qualities),
+                f(p.write),
+                f(p.read),
+            ));
+        }
+    }
     s
 }
 
@@ -207,7 +253,25 @@ mod tests {
             "mesh": {"adaptive": {"stop": "converged", "target_error_rel": 0.03}},
             "fem": {"total_s": 6.0}
         });
-        let d = design_row(Path::new("designs/x.stl"), &v, 7.0).unwrap();
+        let mut d = design_row(Path::new("designs/x.stl"), &v, 7.0).unwrap();
+        assert!(d.iterations.iter().all(|r| r.mesh_phases.is_none()));
+        assert!(
+            !markdown(&AdaptiveBench {
+                designs: vec![d.clone()]
+            })
+            .contains("phase by phase")
+        );
+        // a record whose mesher reported its phases gets the third table
+        let mut phased = v.clone();
+        phased["fx"]["adaptive"][1]["timings"]["mesh_phases"] = serde_json::json!({
+            "model": 0.01, "mesh_1d": 0.2, "mesh_2d": 0.4, "mesh_3d": 0.3, "order_2": 0.05,
+            "qualities": 0.02, "write": 0.1, "read": 0.03});
+        let p = design_row(Path::new("designs/x.stl"), &phased, 7.0).unwrap();
+        assert_eq!(p.iterations[1].mesh_phases.unwrap().mesh_2d, Some(0.4));
+        assert!(markdown(&AdaptiveBench { designs: vec![p] }).contains(
+            "| x | 1 | 1.00 | 0.01 | 0.20 | 0.40 | 0.30 | – | 0.05 | 0.02 | 0.10 | 0.03 |"
+        ));
+        d.design = "x".into();
         assert_eq!(d.design, "x");
         assert_eq!(d.iterations.len(), 2);
         let r = &d.iterations[1];

@@ -50,7 +50,8 @@ use super::material::Material;
 use super::mesh::{TetMesh, dist};
 use super::recovery::node_elements;
 use super::rod::{
-    AdaptiveStep, DEFAULT_FIXED_BAND_M, RodOptions, RodSolution, StepTimings, solve_rod_fields,
+    AdaptiveStep, DEFAULT_FIXED_BAND_M, MeshPhases, RodOptions, RodSolution, StepTimings,
+    solve_rod_fields,
 };
 use super::shape::TET10_EDGES;
 
@@ -105,6 +106,11 @@ pub struct MeshAsk<'a> {
 pub trait Mesher {
     /// The mesh asked for, and the seconds it took to make.
     fn mesh(&mut self, ask: &MeshAsk<'_>) -> Result<(TetMesh, f64)>;
+
+    /// Where the last mesh's time went, if the mesher knows (gmsh does); `None` by default.
+    fn last_phases(&self) -> Option<MeshPhases> {
+        None
+    }
 }
 
 impl<F: FnMut(&MeshAsk<'_>) -> Result<(TetMesh, f64)>> Mesher for F {
@@ -304,6 +310,7 @@ pub fn adaptive_rod(
             size_map,
         };
         let (mesh, secs) = mesher.mesh(&ask)?;
+        let mesh_phases = mesher.last_phases();
         mesh_s += secs;
         let last = iteration + 1 >= opts.max_iterations;
         let sol = solve_rod_fields(&mesh, material, bores, force_n, &rod_opts)?;
@@ -340,6 +347,7 @@ pub fn adaptive_rod(
                 seconds: 0.0,
                 timings: StepTimings {
                     mesh_s: secs,
+                    mesh_phases,
                     analysis_s: sol.result.total_s,
                     analysis: sol.result.timings,
                 },

@@ -181,6 +181,37 @@ pub struct StepTimings {
     pub analysis_s: f64,
     #[serde(flatten)]
     pub analysis: Timings,
+    /// The mesh's own phases, where the mesher reports them (gmsh: [`MeshPhases`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mesh_phases: Option<MeshPhases>,
+}
+
+/// Where one gmsh mesh's time went, s (gmsh's own wall times from its log, the rest measured
+/// around the calls; `pipeline/mesh_rod.py`, `mesh_volume`). `model`: building the model before
+/// meshing (on the first mesh of an STL the classification of its triangles; in the loop's gmsh
+/// session the next model is built while the last mesh is solved, so later meshes show only the
+/// options set); `hxt_optimise` is part of `mesh_3d`; `read`: reading the written mesh on the
+/// Rust side. A phase the mesher did not report is absent (`None`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct MeshPhases {
+    #[serde(default)]
+    pub model: Option<f64>,
+    #[serde(default)]
+    pub mesh_1d: Option<f64>,
+    #[serde(default)]
+    pub mesh_2d: Option<f64>,
+    #[serde(default)]
+    pub mesh_3d: Option<f64>,
+    #[serde(default)]
+    pub hxt_optimise: Option<f64>,
+    #[serde(default)]
+    pub order_2: Option<f64>,
+    #[serde(default)]
+    pub qualities: Option<f64>,
+    #[serde(default)]
+    pub write: Option<f64>,
+    #[serde(default)]
+    pub read: Option<f64>,
 }
 
 /// A bore as found.

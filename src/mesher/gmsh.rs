@@ -17,6 +17,7 @@ use serde::{Deserialize, Serialize};
 use super::rodmesh::read_rodmesh;
 use crate::fem::TetMesh;
 use crate::fem::error::{FemError, Result};
+use crate::fem::rod::MeshPhases;
 
 /// What the mesher reports (quality figures from gmsh's `getElementQualities`).
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -61,6 +62,12 @@ pub struct MeshReport {
     /// Wall time including Python start-up, s (measured here).
     #[serde(default)]
     pub seconds_wall: f64,
+    /// Building the model before meshing (the classification on a first mesh), s.
+    #[serde(default)]
+    pub seconds_geometry: Option<f64>,
+    /// Where the mesh's time went (gmsh's phases from its log, and the read measured here).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub phases_s: Option<MeshPhases>,
 }
 
 /// A mesh made from an STL, with the mesher's report.
@@ -185,6 +192,7 @@ pub(super) fn read_reported(json: &str, secs: f64) -> Result<MeshedRod> {
     let mut report: MeshReport = serde_json::from_str(json)
         .map_err(|e| FemError::Mesher(format!("cannot parse the mesher's report ({e}): {json}")))?;
     report.seconds_wall = secs;
+    let t_read = Instant::now();
     let (mesh, file) = match &report.rodmesh {
         Some(rodmesh) => (read_rodmesh(rodmesh)?, rodmesh.clone()),
         None => {
@@ -194,6 +202,10 @@ pub(super) fn read_reported(json: &str, secs: f64) -> Result<MeshedRod> {
             (mesh, report.msh.clone())
         }
     };
+    if let Some(p) = report.phases_s.as_mut() {
+        p.model = report.seconds_geometry;
+        p.read = Some(t_read.elapsed().as_secs_f64());
+    }
     if mesh.n_elements() != report.elements {
         return Err(FemError::Mesher(format!(
             "{} has {} elements, the mesher reported {}",

@@ -13,6 +13,7 @@ use super::size_field::write_size_field;
 use crate::fem::adapt::{MeshAsk, Mesher};
 use crate::fem::error::{FemError, Result};
 use crate::fem::mesh::TetMesh;
+use crate::fem::rod::MeshPhases;
 
 /// gmsh on one rod: its surface (an STL in millimetres, in the rod frame), or the exact geometry
 /// of its STEP file moved into the rod frame.
@@ -197,6 +198,10 @@ impl Mesher for GmshRodMesher {
     /// remesh a faceted surface coarsely where thin features meet ("overlapping facets"); the
     /// mesher then tries its fallbacks (`mesh_rod.py`'s `FALLBACKS`), and a mesh that still fails
     /// is asked again with all sizes × 0.8, twice at most.
+    fn last_phases(&self) -> Option<MeshPhases> {
+        self.last_report.as_ref().and_then(|r| r.phases_s)
+    }
+
     fn mesh(&mut self, ask: &MeshAsk<'_>) -> Result<(TetMesh, f64)> {
         let dir = self.work_dir.join(format!("adapt{}", ask.iteration));
         std::fs::create_dir_all(&dir)
