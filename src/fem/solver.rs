@@ -1,6 +1,7 @@
 //! Sparse direct solution with faer's Cholesky factorisation (LLᵀ): a nested-dissection ordering
 //! from the mesh ([`super::ordering`]; faer's approximate minimum degree without one), supernodal
-//! when the flop count warrants it, factorised on one thread, solved on the global rayon pool. The
+//! when the flop count warrants it, factorised on one thread (on the whole rayon pool above
+//! [`PARALLEL_FLOPS`]), solved on the global rayon pool. The
 //! symbolic analysis is kept in a reference-counted [`SymbolicFactor`] and can be reused for any
 //! matrix with the same pattern; all load cases are solved together from one factorisation.
 
@@ -72,6 +73,33 @@ impl SymbolicFactor {
     pub fn nnz_l(&self) -> usize {
         self.inner.len_val()
     }
+
+    /// Floating-point operations of the numeric factorisation, estimated from the supernodes: a
+    /// supernode of w columns with m rows below its diagonal block costs w³/3 (its dense
+    /// Cholesky) + m·w² (the triangular solve below it) + m²·w (its update of the ancestors)
+    /// (George & Liu, *Computer Solution of Large Sparse Positive Definite Systems*, 1981, §2.2
+    /// for the column counts). A simplicial factor (small problems): Σ_j c_j², c_j the entries of
+    /// column j.
+    pub fn flops(&self) -> f64 {
+        use faer::sparse::linalg::cholesky::SymbolicCholeskyRaw;
+        match self.inner.raw() {
+            SymbolicCholeskyRaw::Supernodal(sn) => {
+                let rows = sn.col_ptr_for_row_idx();
+                (0..sn.n_supernodes())
+                    .map(|s| {
+                        let w = (sn.supernode_end()[s] - sn.supernode_begin()[s]) as f64;
+                        let m = (rows[s + 1] - rows[s]) as f64;
+                        w * w * w / 3.0 + m * w * w + m * m * w
+                    })
+                    .sum()
+            }
+            SymbolicCholeskyRaw::Simplicial(sp) => sp
+                .col_ptr()
+                .windows(2)
+                .map(|c| ((c[1] - c[0]) as f64).powi(2))
+                .sum(),
+        }
+    }
 }
 
 /// A 64-bit fingerprint of the pattern of `a` (FNV-1a over the column pointers and row indices).
@@ -88,6 +116,13 @@ fn symbolic_ref(a: &SparseSym) -> SymbolicSparseColMatRef<'_, usize> {
     SymbolicSparseColMatRef::new_checked(a.n, a.n, &a.col_ptr, None, &a.row_idx)
 }
 
+/// Factorisations of at least this many floating-point operations ([`SymbolicFactor::flops`])
+/// use every thread of the rayon pool, smaller ones one: on the 2-core machine, in the adaptive
+/// loop, design 1's refined second mesh (1.2e11 flops) factorised in 2.24–2.31 s on two threads
+/// against 2.80–2.83 s on one, its 2.7e10 and 3.0e10 meshes in 1.06–1.09 s against 0.84–0.93 s
+/// (docs/fem.md, session 23). faer's parallel factorisation gives the same bits.
+pub const PARALLEL_FLOPS: f64 = 7e10;
+
 /// A numeric Cholesky factor.
 #[derive(Debug)]
 pub struct CholeskyFactor {
@@ -99,15 +134,24 @@ impl CholeskyFactor {
     /// Factorises `a` (whose pattern `symbolic` was made from). A matrix that is not positive
     /// definite (a model that is not fully supported) is an error.
     pub fn factorise(symbolic: &SymbolicFactor, a: &SparseSym) -> Result<Self> {
+        // sequential below PARALLEL_FLOPS: on the 2-core machine faer's parallel dense kernels
+        // cost more than they gain on a rod's usual supernodes (72 kDOF: 0.48 s against 0.63 s;
+        // 169 kDOF: 2.26 s against 2.33 s), and the study already runs designs side by side
+        let par = if symbolic.flops() >= PARALLEL_FLOPS {
+            Par::rayon(0)
+        } else {
+            Par::Seq
+        };
+        Self::factorise_with(symbolic, a, par)
+    }
+
+    /// [`Self::factorise`] with the parallelism given.
+    fn factorise_with(symbolic: &SymbolicFactor, a: &SparseSym, par: Par) -> Result<Self> {
         if symbolic.n() != a.n {
             return Err(FemError::Solver(
                 "symbolic factor of another dimension".into(),
             ));
         }
-        // sequential: on the 2-core machine faer's parallel dense kernels cost more than they gain
-        // on a rod's supernodes (72 kDOF: 0.48 s against 0.63 s; 169 kDOF: 2.26 s against 2.33 s),
-        // and the study already runs designs side by side
-        let par = Par::Seq;
         let s = &*symbolic.inner;
         let mut l_values = Vec::new();
         l_values.try_reserve_exact(s.len_val()).map_err(|_| {
@@ -159,5 +203,86 @@ impl CholeskyFactor {
     /// The symbolic analysis used.
     pub fn symbolic(&self) -> &SymbolicFactor {
         &self.symbolic
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The upper triangle of a symmetric matrix from its (row ≤ column) entries.
+    fn upper(n: usize, entry: impl Fn(usize, usize) -> Option<f64>) -> SparseSym {
+        let (mut col_ptr, mut row_idx, mut values) = (vec![0], Vec::new(), Vec::new());
+        for j in 0..n {
+            for i in 0..=j {
+                if let Some(v) = entry(i, j) {
+                    row_idx.push(i);
+                    values.push(v);
+                }
+            }
+            col_ptr.push(row_idx.len());
+        }
+        SparseSym {
+            n,
+            col_ptr,
+            row_idx,
+            values,
+        }
+    }
+
+    #[test]
+    fn the_flop_count_is_a_dense_choleskys_on_a_dense_matrix_and_linear_on_a_band() {
+        // dense n × n: one supernode (or n columns of n − j entries), n³/3 to leading order
+        let n = 60;
+        let dense = upper(n, |i, j| Some(if i == j { 2.0 * n as f64 } else { 1.0 }));
+        let f = SymbolicFactor::analyse(&dense, None).unwrap().flops();
+        let n3 = (n * n * n) as f64 / 3.0;
+        assert!((f / n3 - 1.0).abs() < 0.1, "{f:e} against {n3:e}");
+        // tridiagonal: no fill, a few operations per column
+        let n = 2000;
+        let band = upper(n, |i, j| match j - i {
+            0 => Some(2.0),
+            1 => Some(-1.0),
+            _ => None,
+        });
+        let f = SymbolicFactor::analyse(&band, None).unwrap().flops();
+        assert!(f > n as f64 && f < 10.0 * n as f64, "{f:e}");
+    }
+
+    #[test]
+    fn the_parallel_factorisation_gives_the_sequential_bits() {
+        // a 3D 7-point Laplacian (plus the identity), 18³ unknowns, in the natural order
+        let m = 18;
+        let idx = |x: usize, y: usize, z: usize| x + m * (y + m * z);
+        let n = m * m * m;
+        let a = upper(n, |i, j| {
+            if i == j {
+                return Some(7.0);
+            }
+            let (xi, yi, zi) = (i % m, (i / m) % m, i / (m * m));
+            let (xj, yj, zj) = (j % m, (j / m) % m, j / (m * m));
+            let neighbour = [
+                idx(xi + 1, yi, zi),
+                idx(xi, yi + 1, zi),
+                idx(xi, yi, zi + 1),
+            ];
+            ((xi + 1 < m && neighbour[0] == j && yi == yj && zi == zj)
+                || (yi + 1 < m && neighbour[1] == j && xi == xj && zi == zj)
+                || (zi + 1 < m && neighbour[2] == j && xi == xj && yi == yj))
+                .then_some(-1.0)
+        });
+        let sym = SymbolicFactor::analyse(&a, None).unwrap();
+        let seq = CholeskyFactor::factorise_with(&sym, &a, Par::Seq).unwrap();
+        let par = CholeskyFactor::factorise_with(&sym, &a, Par::rayon(2)).unwrap();
+        assert!(
+            seq.l_values
+                .iter()
+                .zip(&par.l_values)
+                .all(|(x, y)| x.to_bits() == y.to_bits())
+        );
+        let (mut x, mut y) = (vec![1.0; n], vec![1.0; n]);
+        seq.solve_in_place(&mut x, 1);
+        par.solve_in_place(&mut y, 1);
+        assert_eq!(x, y);
     }
 }
