@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 
 use rodstudy::mesher::gmsh_session::GmshSession;
 use rodstudy::mesher::size_field::write_size_field;
+use rodstudy::mesher::volume::read_volume_mesh_native;
 use rodstudy::mesher::{MeshRequest, mesh_stl_with};
 
 fn python() -> PathBuf {
@@ -125,6 +126,32 @@ fn a_session_makes_the_meshes_of_fresh_processes_file_for_file() {
         );
         assert!(p.hxt_optimise <= p.mesh_3d, "{p:?}");
     }
+    // the meshes read natively are written binary and read as their ASCII print: the same mesh
+    // written ASCII (the .rodmesh route writes the .msh in ASCII) reads to the same bits
+    assert!(second.report.msh_binary && b.report.msh_binary);
+    let ascii = MeshRequest {
+        size_mm: 10.0,
+        size_field: Some(&field),
+        geometry: Some(&geometry),
+        name: Some("rod"),
+        native_read: false,
+    };
+    let ascii = mesh_stl_with(&python(), &script(), &stl(), &ascii, &fresh.join("m1a")).unwrap();
+    assert!(!ascii.report.msh_binary);
+    let from_ascii = read_volume_mesh_native(&ascii.report.msh, "mm").unwrap();
+    let exact = read_volume_mesh_native(&second.report.msh, "mm").unwrap();
+    assert_eq!(from_ascii.elements(), second.mesh.elements());
+    let same = |m: &rodstudy::fem::TetMesh| {
+        m.nodes()
+            .iter()
+            .flatten()
+            .zip(from_ascii.nodes().iter().flatten())
+            .filter(|(x, y)| x.to_bits() != y.to_bits())
+            .count()
+    };
+    assert_eq!(same(&second.mesh), 0, "the binary mesh read as ASCII");
+    // (and read exactly, the binary file's coordinates are not the ASCII print's)
+    assert!(same(&exact) > 0);
     // the classification is in the first mesh's model, not in a later one's
     let model = |m: &rodstudy::mesher::MeshedRod| m.report.phases_s.unwrap().model.unwrap();
     assert!(

@@ -65,6 +65,10 @@ pub struct MeshReport {
     /// Building the model before meshing (the classification on a first mesh), s.
     #[serde(default)]
     pub seconds_geometry: Option<f64>,
+    /// The `.msh` was written binary in place of ASCII (a natively read mesh): its coordinates are
+    /// read rounded as the ASCII file prints them ([`super::volume::read_msh_as_ascii`]).
+    #[serde(default)]
+    pub msh_binary: bool,
     /// Where the mesh's time went (gmsh's phases from its log, and the read measured here).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub phases_s: Option<MeshPhases>,
@@ -196,7 +200,11 @@ pub(super) fn read_reported(json: &str, secs: f64) -> Result<MeshedRod> {
     let (mesh, file) = match &report.rodmesh {
         Some(rodmesh) => (read_rodmesh(rodmesh)?, rodmesh.clone()),
         None => {
-            let mesh = super::volume::read_volume_mesh_native(&report.msh, "mm")?;
+            let mesh = if report.msh_binary {
+                super::volume::read_msh_as_ascii(&report.msh, "mm")?
+            } else {
+                super::volume::read_volume_mesh_native(&report.msh, "mm")?
+            };
             // gmsh's count may hold nodes no tetrahedron uses; the reader keeps the used ones
             report.nodes = mesh.n_nodes();
             (mesh, report.msh.clone())
