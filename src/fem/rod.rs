@@ -193,24 +193,16 @@ pub struct StepTimings {
 /// options set); `hxt_optimise` is part of `mesh_3d`; `read`: reading the written mesh on the
 /// Rust side. A phase the mesher did not report is absent (`None`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct MeshPhases {
-    #[serde(default)]
     pub model: Option<f64>,
-    #[serde(default)]
     pub mesh_1d: Option<f64>,
-    #[serde(default)]
     pub mesh_2d: Option<f64>,
-    #[serde(default)]
     pub mesh_3d: Option<f64>,
-    #[serde(default)]
     pub hxt_optimise: Option<f64>,
-    #[serde(default)]
     pub order_2: Option<f64>,
-    #[serde(default)]
     pub qualities: Option<f64>,
-    #[serde(default)]
     pub write: Option<f64>,
-    #[serde(default)]
     pub read: Option<f64>,
 }
 
