@@ -111,33 +111,32 @@ pub fn run(args: FemArgs) -> Result<i32> {
         }
         return Ok(0);
     }
-    // the factorised K of the final mesh is kept for the buckling case (the same supports)
-    let keep = !args.no_buckling;
-    let mut outcome =
-        stages::fem::fem_keeping(&design, force, &config, &args.out.join("mesh"), &mode, keep)?;
-    // buckling unless --no-buckling: under --force if given, else the peak compression (with a pressure
-    // trace, where stage 3 has computed and judged it already) or the peak pin force (F_x)
+    // buckling unless --no-buckling: under --force if given, else the peak compression (with a
+    // pressure trace, where stage 3 computes and judges it itself) or the peak pin force (F_x);
+    // stage 3 runs it beside its geometry check, on the factorised K of the final mesh (the same
+    // supports)
+    let engine = config.engine.pressure_trace.is_some();
+    let buckling_n = match (args.no_buckling, args.force) {
+        (true, _) => None,
+        (false, Some(f)) => Some(f),
+        (false, None) if engine => None,
+        (false, None) => Some(stages::fem::buckling_load(&design, &config)?),
+    };
+    let mut outcome = stages::fem::fem_and_buckling(
+        &design,
+        force,
+        &config,
+        &args.out.join("mesh"),
+        &mode,
+        false,
+        buckling_n,
+    )?;
     let mut buckling_cost: Option<(f64, usize)> = None;
-    if !args.no_buckling && (outcome.record.buckling_load_factor.is_none() || args.force.is_some())
-    {
-        let load = match args.force {
-            Some(f) => f,
-            None => stages::fem::buckling_load(&design, &config)?,
-        };
-        match stages::fem::buckling(
-            &outcome.mesh,
-            &config,
-            load,
-            outcome.solution.system.as_deref(),
-        ) {
+    if let Some(run) = outcome.buckling_run.take() {
+        match run.result {
             Ok(b) => {
                 buckling_cost = Some((b.static_s + b.geometric_s + b.iteration_s, b.iterations));
-                outcome.record.buckling_load_factor = Some(b.load_factor);
-                outcome.solution.buckling = Some(crate::fem::buckling::BucklingMode {
-                    load_factor: b.load_factor,
-                    load_n: load,
-                    mode: b.mode,
-                });
+                stages::fem::apply_buckling(&mut outcome, run.compression_n, b, None);
             }
             Err(e) => {
                 outcome.record.buckling_load_factor = None;
