@@ -7,6 +7,8 @@
 //! 2. The same column in tension: refused, with its message.
 //! 3. Design 1 at 8 mm against CalculiX `*BUCKLE` on the identical mesh, supports and nodal loads
 //!    (`pipeline/ccx_peer.py --buckle`), within 1 % (needs Python with gmsh and `ccx`).
+//! 4. Stage 3's buckling run beside its geometry check (`stages::fem::fem_and_buckling`) is the
+//!    analysis run after it on the same mesh and factorisation, to the bit (needs gmsh).
 
 use std::path::{Path, PathBuf};
 
@@ -180,4 +182,48 @@ fn design1_against_calculix_buckle() {
         "ours {} against ccx {ccx}",
         ours.load_factor
     );
+}
+
+#[test]
+fn the_buckling_beside_the_geometry_check_is_the_one_after_it() {
+    use rodstudy::config::StudyConfig;
+    use rodstudy::stages;
+    use rodstudy::stages::fem::MeshMode;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = tempfile::tempdir().unwrap();
+    let design = stages::mass::load(&root.join("designs/design1.stl")).unwrap();
+    let config = StudyConfig::default();
+    let load = 7000.0;
+    let out = stages::fem::fem_and_buckling(
+        &design,
+        load,
+        &config,
+        dir.path(),
+        &MeshMode::Fixed(8.0),
+        true,
+        Some(load),
+    )
+    .unwrap();
+    // the STL's geometry check ran, and the buckling beside it
+    assert!(out.record.fem.geometry_check.is_some());
+    let run = out.buckling_run.as_ref().expect("asked for");
+    assert_eq!(run.compression_n, load);
+    let beside = run.result.as_ref().unwrap();
+    let after =
+        stages::fem::buckling(&out.mesh, &config, load, out.solution.system.as_deref()).unwrap();
+    assert_eq!(beside.load_factor.to_bits(), after.load_factor.to_bits());
+    assert!(beside.load_factor > 1.0, "{}", beside.load_factor);
+    assert_eq!(beside.mode, after.mode);
+    // without a load asked for, none is run
+    let none = stages::fem::fem_and_buckling(
+        &design,
+        load,
+        &config,
+        &dir.path().join("again"),
+        &MeshMode::Fixed(8.0),
+        false,
+        None,
+    )
+    .unwrap();
+    assert!(none.buckling_run.is_none() && none.solution.system.is_none());
 }
