@@ -122,28 +122,16 @@ pub fn fem(
     work_dir: &Path,
     mode: &MeshMode,
 ) -> Result<FemOutcome> {
-    fem_keeping(design, force_n, config, work_dir, mode, false)
+    fem_and_buckling(design, force_n, config, work_dir, mode, false, None)
 }
 
 /// [`fem`]; `keep_system`: the outcome keeps the factorised K of the final mesh
-/// ([`RodSolution::system`]) for a buckling analysis the caller runs on it (`fem` itself keeps it
-/// while it judges buckling in the engine study, then drops it).
-pub fn fem_keeping(
-    design: &LoadedDesign,
-    force_n: f64,
-    config: &StudyConfig,
-    work_dir: &Path,
-    mode: &MeshMode,
-    keep_system: bool,
-) -> Result<FemOutcome> {
-    fem_and_buckling(design, force_n, config, work_dir, mode, keep_system, None)
-}
-
-/// [`fem_keeping`], and with `buckling_n` a buckling analysis under that compression (N) on the
-/// final mesh, left in [`FemOutcome::buckling_run`] for the caller to apply ([`apply_buckling`]).
-/// The engine study (a pressure trace) judges buckling under the peak compression itself (an
-/// error there is stage 3's). Either buckling analysis runs beside the geometry check of an STL
-/// (each mostly on one core: 1.0–2.1 s less of `fem DESIGN` on the five designs).
+/// ([`RodSolution::system`]) for an analysis the caller runs on it; with `buckling_n` a buckling
+/// analysis under that compression (N) on the final mesh, left in [`FemOutcome::buckling_run`]
+/// for the caller to apply ([`apply_buckling`]). The engine study (a pressure trace) judges
+/// buckling under the peak compression itself (an error there is stage 3's). Either buckling
+/// analysis runs beside the geometry check of an STL (`fem DESIGN`'s time beyond the adaptive
+/// loop 0.1–1.0 s less on the five designs; docs/fem.md, session 23).
 pub fn fem_and_buckling(
     design: &LoadedDesign,
     force_n: f64,
@@ -252,7 +240,7 @@ pub fn buckling_load(design: &LoadedDesign, config: &StudyConfig) -> Result<f64>
 /// Linear buckling of the rod on stage 3's mesh (supports as stage 3: bore B fixed) under the
 /// compression `compression_n` on bore A towards B (the F_x case;
 /// [`crate::fem::rod_buckling::rod_buckling`]): the smallest positive load factor λ₁ and its mode.
-/// `system`: the factorised K of stage 3 on this mesh, if kept ([`fem_keeping`]).
+/// `system`: the factorised K of stage 3 on this mesh, if kept ([`fem_and_buckling`]).
 pub fn buckling(
     stage: &StageMesh,
     config: &StudyConfig,
