@@ -110,7 +110,7 @@ pub struct FemOutcome {
 /// A buckling analysis of stage 3's final mesh under `compression_n` (N), and what came of it.
 pub struct BucklingRun {
     pub compression_n: f64,
-    pub result: crate::fem::Result<BucklingSolution>,
+    pub result: Result<BucklingSolution>,
 }
 
 /// Stage 3 of a loaded design under `force_n` in the mode asked for; gmsh's files go under
@@ -159,12 +159,7 @@ pub fn fem_and_buckling(
             let mut outcome = fem_user_mesh(design, force_n, config, work_dir, file, keep)?;
             outcome.buckling_run = beside.map(|n| BucklingRun {
                 compression_n: n,
-                result: rod_buckling_on(
-                    &outcome.mesh,
-                    config,
-                    n,
-                    outcome.solution.system.as_deref(),
-                ),
+                result: buckling(&outcome.mesh, config, n, outcome.solution.system.as_deref()),
             });
             Ok(outcome)
         }
@@ -182,12 +177,7 @@ pub fn fem_and_buckling(
         if let Some(n) = buckling_n {
             outcome.buckling_run = Some(BucklingRun {
                 compression_n: n,
-                result: rod_buckling_on(
-                    &outcome.mesh,
-                    config,
-                    n,
-                    outcome.solution.system.as_deref(),
-                ),
+                result: buckling(&outcome.mesh, config, n, outcome.solution.system.as_deref()),
             });
         }
     }
@@ -247,23 +237,13 @@ pub fn buckling(
     compression_n: f64,
     system: Option<&FactorisedSystem>,
 ) -> Result<BucklingSolution> {
-    Ok(rod_buckling_on(stage, config, compression_n, system)?)
-}
-
-/// [`buckling`] with the analysis' own error.
-fn rod_buckling_on(
-    stage: &StageMesh,
-    config: &StudyConfig,
-    compression_n: f64,
-    system: Option<&FactorisedSystem>,
-) -> crate::fem::Result<BucklingSolution> {
-    rod_buckling_with(
+    Ok(rod_buckling_with(
         &stage.mesh,
         &Material::from(&config.fem),
         &stage.bores,
         compression_n,
         system,
-    )
+    )?)
 }
 
 /// The rod's buckling analysis with stage 3's settings.
@@ -529,7 +509,8 @@ impl Setup {
         let buckle = || {
             buckling_n.map(|n| BucklingRun {
                 compression_n: n,
-                result: rod_buckling_with(mesh, &self.material, &self.bores, n, system.as_deref()),
+                result: rod_buckling_with(mesh, &self.material, &self.bores, n, system.as_deref())
+                    .map_err(Into::into),
             })
         };
         let r = &mut solution.result;
