@@ -563,3 +563,60 @@ fn a_small_fillet_cut_into_45_degree_facets_is_refined_not_excluded() {
         plain.fem.warnings
     );
 }
+
+/// A STEP's curved meshes are the same on every run (they were not while gmsh's high-order
+/// optimiser made them valid: it visits the elements in the order of their memory addresses).
+/// The curved elements whose scaled Jacobian is below 0.1 are made straight-sided instead
+/// (`mesh_rod.py`'s `straighten_poor_curved`). The foreign fillet rod (R1 on every edge, far
+/// below the 4 mm elements) meshed twice, in folders whose names differ in length (the paths a
+/// process reads shift its heap): the same file byte for byte; every element valid with a scaled
+/// Jacobian of at least 0.1 (straight-sided elements are as good as their corner tetrahedra);
+/// some elements made straight, and nearly all curved ones left curved on the exact surface.
+#[test]
+fn a_steps_curved_mesh_is_the_same_on_every_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = Command::new(python().unwrap())
+        .arg(pipeline_script("foreign_rods.py"))
+        .arg(dir.path())
+        .args(["--only", "fillets"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mesh_in = |folder: &str| {
+        let out = dir.path().join(folder);
+        let o = Command::new(python().unwrap())
+            .arg(pipeline_script("mesh_rod.py"))
+            .arg("mesh-step")
+            .arg(dir.path().join("fillets.step"))
+            .arg(&out)
+            .args(["--frame", "0,0,0,1,0,0,0,1,0,0,0,1", "--scale", "1"])
+            .args(["--size", "4", "--no-rodmesh"])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let info: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        (std::fs::read(out.join("fillets.msh")).unwrap(), info)
+    };
+    let (a, info) = mesh_in("a");
+    let (b, _) = mesh_in("a_folder_with_a_much_longer_name");
+    assert!(a == b, "two runs gave two meshes");
+    let elements = info["elements"].as_u64().unwrap() as usize;
+    let straightened = info["curved_elements_straightened"].as_u64().unwrap() as usize;
+    let min_sj = info["min_scaled_jacobian"].as_f64().unwrap();
+    let mesh =
+        rodstudy::mesher::volume::read_volume_mesh_native(&dir.path().join("a/fillets.msh"), "mm")
+            .unwrap();
+    let curved = mesh.curved_elements();
+    println!(
+        "fillets.step at 4 mm: {elements} tet10, {curved} curved, {straightened} made straight-sided, min scaled Jacobian {min_sj:.3}"
+    );
+    assert_eq!(mesh.n_elements(), elements);
+    assert!(min_sj >= 0.1, "{min_sj}");
+    assert!(straightened > 0, "the R1 fillets under 4 mm elements");
+    assert!(
+        curved > 10 * straightened,
+        "{curved} curved against {straightened} straightened"
+    );
+    mesh.check_jacobians(rodstudy::fem::QuadratureChoice::default())
+        .unwrap();
+}

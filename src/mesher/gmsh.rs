@@ -72,6 +72,10 @@ pub struct MeshReport {
     /// Where the mesh's time went (gmsh's phases from its log, and the read measured here).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub phases_s: Option<MeshPhases>,
+    /// A STEP's curved mesh: the elements made straight-sided because their scaled Jacobian was
+    /// below 0.1 (`mesh_rod.py`'s `straighten_poor_curved`); `None` for an STL's mesh.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub curved_elements_straightened: Option<usize>,
 }
 
 /// A mesh made from an STL, with the mesher's report.

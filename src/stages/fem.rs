@@ -611,6 +611,7 @@ pub fn fem_fixed(
         adaptive: None,
         surface_triangles: setup.surface_triangles(),
         fallback: joined(&mesher.fallbacks),
+        curved_elements_straightened: r.curved_elements_straightened,
     };
     let mut outcome = setup.outcome(force_n, config, summary, meshed.mesh, solution);
     outcome.buckling_run = buckling_run;
@@ -697,6 +698,7 @@ pub fn fem_adaptive(
         }),
         surface_triangles: setup.surface_triangles(),
         fallback: joined(&mesher.fallbacks),
+        curved_elements_straightened: r.curved_elements_straightened,
     };
     let mut outcome = setup.outcome(force_n, config, summary, out.mesh, out.solution);
     outcome.buckling_run = buckling_run;
@@ -763,6 +765,7 @@ pub fn fem_user_mesh(
         adaptive: None,
         surface_triangles: setup.surface_triangles(),
         fallback: None,
+        curved_elements_straightened: None,
     };
     Ok(setup.outcome(force_n, config, summary, mesh, solution))
 }

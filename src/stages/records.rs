@@ -94,6 +94,11 @@ pub struct MeshSummary {
     /// one, joined by "; "); absent for the usual mesh.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fallback: Option<String>,
+    /// A STEP's curved mesh (the last one of an adaptive sequence): the elements made
+    /// straight-sided because their scaled Jacobian was below 0.1 (a fillet far smaller than the
+    /// elements); absent for an STL's or a user's mesh.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub curved_elements_straightened: Option<usize>,
 }
 
 /// How an adaptive sequence went.
