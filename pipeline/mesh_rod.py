@@ -1066,7 +1066,7 @@ GMSH_TET10_EDGES = ((0, 1), (1, 2), (2, 0), (3, 0), (3, 2), (3, 1))
 CURVED_SJ_MIN = 0.1
 
 
-def straighten_poor_curved(threshold: float = CURVED_SJ_MIN, rounds: int = 6) -> dict:
+def straighten_poor_curved(threshold: float = CURVED_SJ_MIN) -> dict:
     """Makes the curved 10-node tetrahedra whose minimum scaled Jacobian is below `threshold`
     straight-sided: each midside node of such an element goes back to the midpoint of its edge's
     corners (the neighbours sharing the edge share that straight edge), in rounds until no poor
@@ -1088,7 +1088,7 @@ def straighten_poor_curved(threshold: float = CURVED_SJ_MIN, rounds: int = 6) ->
     x = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
     moved: set[int] = set()
     elements: set[int] = set()
-    for _ in range(rounds):
+    while True:  # each round straightens at least one curved edge, so the rounds end
         sj = np.asarray(gmsh.model.mesh.getElementQualities(tags10, "minSJ"))
         corners = x[row[conn[:, :4]]]
         mids = np.stack([0.5 * (corners[:, a] + corners[:, b]) for a, b in GMSH_TET10_EDGES], axis=1)
