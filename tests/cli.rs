@@ -178,6 +178,46 @@ fn free_run_with_the_energy_projection() {
     assert!(msg.contains("rk45 only"), "{msg}");
 }
 
+/// A plain RK45 run of the conservative free scene whose error against the exact reference
+/// exceeds 10× its tolerance (10 s at atol 1e-9, rtol 0) is told, beside that warning, what keeps
+/// it on the energy integral; the projected run of the same settings meets its tolerance and is
+/// told nothing.
+#[test]
+fn a_drifting_rk45_run_is_pointed_to_the_energy_projection() {
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "dynamics", "free", "--method", "rk45", "--rtol", "0", "--atol", "1e-9", "--t-end",
+            "10", "--json",
+        ];
+        args.extend_from_slice(extra);
+        let o = rodstudy(&args, &[]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_slice::<serde_json::Value>(&o.stdout).unwrap()
+    };
+    let plain = run(&[]);
+    let warnings: Vec<&str> = plain["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| w.as_str().unwrap())
+        .collect();
+    assert!(plain["max_err_phi_rad"].as_f64().unwrap() > 1e-8, "{plain}");
+    assert!(
+        warnings.iter().any(|w| w.contains("exact reference"))
+            && warnings.iter().any(|w| w.contains("--project-energy")),
+        "{warnings:?}"
+    );
+    let projected = run(&["--project-energy"]);
+    assert!(
+        projected["max_err_phi_rad"].as_f64().unwrap() < 1e-8,
+        "{projected}"
+    );
+    assert!(
+        !projected.to_string().contains("--project-energy keeps"),
+        "{projected}"
+    );
+}
+
 /// Issue 13 item 1: `rodstudy mass` gives the mass properties of any closed solid; without bores
 /// at the pins the mechanism-frame fields are null with a warning, and the study still refuses it.
 #[test]

@@ -154,11 +154,26 @@ fn free(args: FreeArgs) -> Result<i32> {
     let mut run = run_free(method, &options).map_err(|e| anyhow::anyhow!("{method}: {e}"))?;
     // the exact reference where the scene has one; warns when the error exceeds 10× the
     // tolerance
+    let warnings_before = run.warnings.len();
     let errors = options
         .scene
         .reference()
         .ok()
         .map(|reference| run.check_against_reference(&reference, &options));
+    // RK45 drifts off the energy integral of a conservative scene over a long run, and the phase
+    // error follows the drift: say what keeps it there (docs/free-run.md)
+    let warned = run.warnings.len() > warnings_before;
+    if warned
+        && method == FreeMethod::Rk45
+        && !options.project_energy
+        && options.scene.loads.is_conservative()
+    {
+        run.warnings.push(
+            "the scene conserves energy and rk45 drifts off it (energy_drift_max_j), which the \
+             phase error follows: --project-energy keeps each step on the energy integral"
+                .into(),
+        );
+    }
     let summary = FreeSummary {
         method: run.method.to_string(),
         model: run.model,
