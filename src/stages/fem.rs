@@ -157,10 +157,7 @@ pub fn fem_and_buckling(
         MeshMode::Adaptive(a) => fem_adaptive(design, force_n, config, work_dir, a, keep, beside),
         MeshMode::User(file) => {
             let mut outcome = fem_user_mesh(design, force_n, config, work_dir, file, keep)?;
-            outcome.buckling_run = beside.map(|n| BucklingRun {
-                compression_n: n,
-                result: buckling(&outcome.mesh, config, n, outcome.solution.system.as_deref()),
-            });
+            outcome.buckling_run = beside.map(|n| buckling_run(&outcome, config, n));
             Ok(outcome)
         }
     }?;
@@ -174,12 +171,7 @@ pub fn fem_and_buckling(
             .with_context(|| format!("{}: buckling", design.file.display()))?;
         apply_buckling(&mut outcome, run.compression_n, b, Some(config));
         // an analysis under another load asked for besides (`fem --force`) runs after
-        if let Some(n) = buckling_n {
-            outcome.buckling_run = Some(BucklingRun {
-                compression_n: n,
-                result: buckling(&outcome.mesh, config, n, outcome.solution.system.as_deref()),
-            });
-        }
+        outcome.buckling_run = buckling_n.map(|n| buckling_run(&outcome, config, n));
     }
     if !keep_system {
         outcome.solution.system = None;
@@ -227,6 +219,19 @@ pub fn buckling_load(design: &LoadedDesign, config: &StudyConfig) -> Result<f64>
         .unwrap_or(dynamics.peak_pin_force_n))
 }
 
+/// [`buckling`] on the outcome's mesh and its kept factorisation, not yet applied.
+fn buckling_run(outcome: &FemOutcome, config: &StudyConfig, compression_n: f64) -> BucklingRun {
+    BucklingRun {
+        compression_n,
+        result: buckling(
+            &outcome.mesh,
+            config,
+            compression_n,
+            outcome.solution.system.as_deref(),
+        ),
+    }
+}
+
 /// Linear buckling of the rod on stage 3's mesh (supports as stage 3: bore B fixed) under the
 /// compression `compression_n` on bore A towards B (the F_x case;
 /// [`crate::fem::rod_buckling::rod_buckling`]): the smallest positive load factor λ₁ and its mode.
@@ -263,24 +268,6 @@ fn rod_buckling_with(
         &BucklingOptions::default(),
         system,
     )
-}
-
-/// [`buckling`] on the outcome's mesh: the factor into the record (and the verdict:
-/// `[criterion] buckling_factor`), the mode into the fields (the report writes
-/// `buckling_mode.vtu`).
-pub fn add_buckling(
-    outcome: &mut FemOutcome,
-    config: &StudyConfig,
-    compression_n: f64,
-) -> Result<()> {
-    let b = buckling(
-        &outcome.mesh,
-        config,
-        compression_n,
-        outcome.solution.system.as_deref(),
-    )?;
-    apply_buckling(outcome, compression_n, b, Some(config));
-    Ok(())
 }
 
 /// A buckling analysis' factor into the record, its mode into the fields (the report writes
