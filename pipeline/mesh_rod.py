@@ -1041,8 +1041,9 @@ def gmsh_step_mesh(step: pathlib.Path, frame: list, scale: float, size_mm: float
         straightened = straighten_poor_curved()
         tags10, min_sj, min_sicn = tet10_qualities()
         if min_sj.min() <= 0.0:
-            raise RuntimeError(f"{int((min_sj <= 0).sum())} element(s) inverted even with straight sides "
-                               f"(min scaled Jacobian {min_sj.min():.3g}): not solved on")
+            raise RuntimeError(f"{step}: {int((min_sj <= 0).sum())} element(s) inverted even with straight sides "
+                               f"(min scaled Jacobian {min_sj.min():.3g}): not solved on; try another element "
+                               f"size, or repair the STEP where faces meet at a sliver")
         if delaunay is False and min_sicn.min() < MIN_SICN:
             raise RuntimeError(f"HXT left a sliver (min SICN {min_sicn.min():.2e} < {MIN_SICN})")
         return {
