@@ -1,6 +1,7 @@
 //! `rodstudy solve DECK.inp`: NAFEMS LE10 at two densities against the published σ_yy at D, the
 //! same decks through CalculiX (ccx) in the same test, an unknown keyword refused with its line,
-//! and a patch test (uniform tension of a C3D10 box by *DLOAD pressure).
+//! a patch test (uniform tension of a C3D10 box by *DLOAD pressure), the same for C3D4 with
+//! supports on corners only, ccx's step semantics, and what a deck cannot mean refused.
 //!
 //! NAFEMS, "The Standard NAFEMS Benchmarks", TNSB Rev. 3 (1990), LE10: σ_yy = −5.38 MPa at
 //! D = (2, 0, 0.3) m. The decks come from `pipeline/nafems_le10.py` (gmsh, the project's Python
@@ -386,4 +387,172 @@ fn patch_test_uniform_tension() {
             assert!((u[0] - sigma * 2.0 / 210000.0).abs() < 1e-12);
         }
     }
+}
+
+/// The box of [`box_deck`] as C3D4 (its tet10 mesh's corners; the midside nodes stay in *NODE,
+/// unused), loaded by `cards` (put after `*STATIC`), with the same supports and output requests.
+fn box_c3d4(cards: &str) -> String {
+    let (tet10, _) = box_deck(100.0, false);
+    let mut s = String::new();
+    let mut in_elements = false;
+    let mut pending: Vec<String> = Vec::new();
+    for line in tet10.lines() {
+        if line.starts_with('*') {
+            in_elements = line.starts_with("*ELEMENT");
+            if line.starts_with("*DLOAD") {
+                break;
+            }
+            s += &line.replace("C3D10", "C3D4");
+            s += "\n";
+            continue;
+        }
+        if in_elements {
+            // id + 7 nodes, then 3 nodes: keep id and the four corners
+            pending.extend(line.split(',').map(|f| f.trim().to_string()));
+            if pending.len() == 11 {
+                s += &(pending[..5].join(", ") + "\n");
+                pending.clear();
+            }
+        } else {
+            s += line;
+            s += "\n";
+        }
+    }
+    s + cards
+        + "*NODE PRINT, NSET=XL, TOTALS=YES\nU, S\n*NODE PRINT, NSET=X0, TOTALS=YES\nRF\n*EL PRINT, ELSET=EALL\nS\n*END STEP\n"
+}
+
+/// The *DLOAD lines of [`box_deck`]: tension `sigma` on the x = lx face.
+fn box_tension(sigma: f64) -> String {
+    let (tet10, _) = box_deck(sigma, false);
+    let from = tet10.find("*DLOAD").unwrap();
+    let to = tet10.find("*NODE PRINT").unwrap();
+    tet10[from..to].to_string()
+}
+
+/// (5) C3D4 is solved as a straight-sided C3D10 with its midside nodes added: a support on the
+/// corners of a face holds the added midside nodes of the face's edges too (as the linear edge of
+/// ccx's C3D4 does), so the patch test holds with supports given on corners only: uniform σ,
+/// u = σ L / E, reactions equal to the load. (Before, the added nodes were free, and the same
+/// deck gave σ_xx between 864 and 1108 for 1000 and u 1–2 % off.)
+#[test]
+fn a_c3d4_patch_test_holds_with_supports_on_corners_only() {
+    let sigma = 100.0;
+    let load = sigma * 1.0 * 0.5;
+    let text = box_c3d4(&box_tension(sigma));
+    let model = read_deck_text(Path::new("box4.inp"), &text).unwrap();
+    let st = &solve_model(&model, SolveOptions::default()).unwrap().steps[0];
+    for el in &st.element_sets["EALL"].s {
+        for ip in el {
+            assert!((ip[0] - sigma).abs() < 1e-9 * sigma, "{ip:?}");
+            assert!(ip[1..].iter().all(|v| v.abs() < 1e-9 * sigma), "{ip:?}");
+        }
+    }
+    // the box's unused midside nodes are printed as zeros (as ccx prints nodes of no element)
+    let xl = st.node_sets["XL"].u.as_ref().unwrap();
+    let used: Vec<_> = xl.iter().filter(|u| u[0] != 0.0).collect();
+    assert_eq!(used.len(), 12, "the corners of the loaded face, 4 × 3");
+    for u in used {
+        assert!((u[0] - sigma * 2.0 / 210000.0).abs() < 1e-12, "{u:?}");
+    }
+    let rx = st.reaction_totals["X0"][0];
+    assert!(
+        (rx + load).abs() < 1e-9 * load,
+        "reaction {rx}, load {load}"
+    );
+    let total = st.node_sets["X0"].rf_total.unwrap();
+    assert!((total[0] + load).abs() < 1e-9 * load, "{total:?}");
+}
+
+/// (6) Step semantics as ccx 2.20 has them: a load given twice within a step adds (two *DLOAD
+/// cards, two GRAV lines), given again in a later step it replaces; a step without *NODE PRINT
+/// keeps the previous step's requests, and the first one in a step replaces them; two requests on
+/// one set print both variables.
+#[test]
+fn loads_repeated_within_a_step_add_and_output_requests_carry_over() {
+    let sigma = 100.0;
+    let u_one = sigma * 2.0 / 210000.0;
+    let tension = box_tension(sigma);
+    let mut text = box_c3d4(&format!("{tension}{tension}"));
+    // a second step: the same tension once (replaces the first step's doubled one), no requests
+    text += &format!("*STEP\n*STATIC\n{tension}*END STEP\n");
+    // a third: gravity along x and along z on the same elements (adds: ρ g V (1, 0, 1); the
+    // tension of step 2 carries over), and a second request on XL
+    text = text.replace("*SOLID SECTION", "*DENSITY\n7.8e-9\n*SOLID SECTION");
+    text += "*STEP\n*STATIC\n*DLOAD\nEALL, GRAV, 9810, 1, 0, 0\nEALL, GRAV, 9810, 0, 0, 1\n*NODE PRINT, NSET=XL\nRF\n*NODE PRINT, NSET=XL\nU\n*END STEP\n";
+    let model = read_deck_text(Path::new("steps.inp"), &text).unwrap();
+    let sol = solve_model(&model, SolveOptions::default()).unwrap();
+    let ux = |k: usize| sol.steps[k].node_sets["XL"].u.as_ref().unwrap()[0][0];
+    assert!((ux(0) - 2.0 * u_one).abs() < 1e-12, "step 1: {}", ux(0));
+    assert!((ux(1) - u_one).abs() < 1e-12, "step 2: {}", ux(1));
+    assert!(
+        sol.steps[1].node_sets.contains_key("X0"),
+        "step 2 keeps the requests"
+    );
+    let weight = 7.8e-9 * 9810.0 * 2.0 * 1.0 * 0.5;
+    let applied = sol.steps[2].applied_total;
+    assert!(
+        (applied[0] - weight - sigma * 0.5).abs() < 1e-9 * sigma
+            && (applied[2] - weight).abs() < 1e-9 * weight,
+        "step 3 applied {applied:?}, gravity ρgV {weight}"
+    );
+    // step 3's first *NODE PRINT replaces the requests carried over: XL's U and RF, no S, no X0
+    let xl = &sol.steps[2].node_sets["XL"];
+    assert!(
+        xl.u.is_some() && xl.rf.is_some() && xl.s.is_none(),
+        "U and RF on XL"
+    );
+    assert!(!sol.steps[2].node_sets.contains_key("X0"));
+}
+
+/// (7) What a deck cannot mean is refused with its line: non-finite numbers, an element turned
+/// inside out (named by its id and line, not its position), and supports that leave a rigid-body
+/// motion free (a single tet held on one edge turns about it).
+#[test]
+fn non_finite_numbers_inverted_elements_and_mechanisms_are_refused() {
+    let tet = |order: &str, support: &str, load: &str| {
+        format!(
+            "*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n3, 0.1, 1.3, 0.2\n4, 0.3, 0.2, 1.7\n5, .5, 0, 0\n\
+             6, .55, .65, .1\n7, .05, .65, .1\n8, .15, .1, .85\n9, .65, .1, .85\n10, .2, .75, .95\n\
+             *ELEMENT, TYPE=C3D10, ELSET=EALL\n57, {order}\n*MATERIAL, NAME=STEEL\n*ELASTIC\n\
+             210000, 0.3\n*SOLID SECTION, ELSET=EALL, MATERIAL=STEEL\n*BOUNDARY\n{support}\
+             *STEP\n*STATIC\n*CLOAD\n{load}\n*END STEP\n"
+        )
+    };
+    let ok = "1,2,3,4,5,6,7,8,9,10";
+    let held = "1,1,3\n2,1,3\n3,1,3\n";
+    // the tet itself solves
+    let model = read_deck_text(Path::new("t.inp"), &tet(ok, held, "4, 2, 1.")).unwrap();
+    assert!(solve_model(&model, SolveOptions::default()).is_ok());
+    for bad in ["nan", "inf", "1e400"] {
+        let err = read_deck_text(Path::new("t.inp"), &tet(ok, held, &format!("4, 2, {bad}")))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("t.inp:25:") && err.contains("not a finite number"),
+            "{bad}: {err}"
+        );
+    }
+    let inverted = "1,3,2,4,7,6,5,8,10,9";
+    let model = read_deck_text(Path::new("t.inp"), &tet(inverted, held, "4, 2, 1.")).unwrap();
+    let err = solve_model(&model, SolveOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("element 57 (line 13)") && err.contains("inverted"),
+        "{err}"
+    );
+    // held on the edge 1-2 (and its midside node): free to turn about it
+    let model = read_deck_text(
+        Path::new("t.inp"),
+        &tet(ok, "1,1,3\n2,1,3\n5,1,3\n", "4, 2, 1."),
+    )
+    .unwrap();
+    let err = solve_model(&model, SolveOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("rigid-body motion"),
+        "a mechanism must be refused: {err}"
+    );
 }

@@ -1,6 +1,7 @@
 //! The cards of a deck read into a [`Model`], keyword by keyword (the subset listed in
 //! [`super::model`]); every keyword, parameter and data form outside it is refused with its line.
 
+use std::collections::BTreeSet;
 use std::path::Path;
 
 use super::model::*;
@@ -39,6 +40,17 @@ impl Model {
         let mut in_step = false;
         let mut first_cload = true;
         let mut first_dload = true;
+        // loads given in the current step: a repeat within the step adds to them (as ccx does), a
+        // repeat in a later step replaces the earlier step's value
+        let mut cloads_here = BTreeSet::new();
+        let mut pressures_here = BTreeSet::new();
+        let mut gravity_here = BTreeSet::new();
+        // output requests: the first card of a kind within a step replaces the requests of that
+        // kind; a step without one keeps the previous step's (ccx's manual, *NODE PRINT, *EL PRINT,
+        // *NODE FILE, *EL FILE)
+        let mut first_request = [true; 4];
+        let mut node_file: Vec<String> = Vec::new();
+        let mut el_file: Vec<String> = Vec::new();
         for card in cards {
             let kw = card.keyword.as_str();
             let Some(allowed) = allowed_params(kw) else {
@@ -278,11 +290,12 @@ impl Model {
                     in_step = true;
                     first_cload = true;
                     first_dload = true;
+                    cloads_here.clear();
+                    pressures_here.clear();
+                    gravity_here.clear();
+                    first_request = [true; 4];
                     state.line = card.line;
                     state.static_seen = false;
-                    state.node_print.clear();
-                    state.el_print.clear();
-                    state.file_vars.clear();
                 }
                 "STATIC" => {
                     if card.data.len() > 1 {
@@ -322,7 +335,12 @@ impl Model {
                             ));
                         }
                         for &n in &nodes {
-                            state.cloads.insert((n, (dof - 1) as usize), v);
+                            let key = (n, (dof - 1) as usize);
+                            if cloads_here.insert(key) {
+                                state.cloads.insert(key, v);
+                            } else {
+                                *state.cloads.get_mut(&key).expect("given in this step") += v;
+                            }
                         }
                     }
                 }
@@ -351,7 +369,11 @@ impl Model {
                                     ));
                                 }
                                 for &e in &elements {
-                                    state.pressures.insert((e, face), p);
+                                    if pressures_here.insert((e, face)) {
+                                        state.pressures.insert((e, face), p);
+                                    } else {
+                                        *state.pressures.get_mut(&(e, face)).expect("given") += p;
+                                    }
                                 }
                             }
                             "GRAV" => {
@@ -370,14 +392,17 @@ impl Model {
                                         "a GRAV line is 'elset, GRAV, g, nx, ny, nz' with a non-zero direction",
                                     ));
                                 }
+                                let this = Grav {
+                                    g,
+                                    dir: dir.map(|v| v / n),
+                                };
                                 for &e in &elements {
-                                    state.gravity.insert(
-                                        e,
-                                        Grav {
-                                            g,
-                                            dir: dir.map(|v| v / n),
-                                        },
-                                    );
+                                    let grav = if gravity_here.insert(e) {
+                                        this
+                                    } else {
+                                        state.gravity[&e].plus(&this)
+                                    };
+                                    state.gravity.insert(e, grav);
                                 }
                             }
                             _ => {
@@ -415,6 +440,18 @@ impl Model {
                             }
                         }
                     }
+                    let kind = ["NODE PRINT", "EL PRINT", "NODE FILE", "EL FILE"]
+                        .iter()
+                        .position(|k| *k == kw)
+                        .expect("one of the four");
+                    if std::mem::replace(&mut first_request[kind], false) {
+                        match kind {
+                            0 => state.node_print.clear(),
+                            1 => state.el_print.clear(),
+                            2 => node_file.clear(),
+                            _ => el_file.clear(),
+                        }
+                    }
                     match kw {
                         "NODE PRINT" => {
                             let set = required(path, card, "NSET")?.to_ascii_uppercase();
@@ -442,11 +479,22 @@ impl Model {
                             state.el_print.push((set, vars));
                         }
                         _ => {
+                            let list = if kind == 2 {
+                                &mut node_file
+                            } else {
+                                &mut el_file
+                            };
                             for v in vars {
-                                if !state.file_vars.contains(&v) {
-                                    state.file_vars.push(v);
+                                if !list.contains(&v) {
+                                    list.push(v);
                                 }
                             }
+                        }
+                    }
+                    state.file_vars = node_file.clone();
+                    for v in &el_file {
+                        if !state.file_vars.contains(v) {
+                            state.file_vars.push(v.clone());
                         }
                     }
                 }

@@ -101,7 +101,11 @@ impl Model {
                     return Err(error(path, start, format!("element {id} defined twice")));
                 }
                 added.push(self.elements.len());
-                self.elements.push(Element { id, nodes });
+                self.elements.push(Element {
+                    id,
+                    nodes,
+                    line: start,
+                });
                 pending.clear();
             }
         }

@@ -26,10 +26,15 @@
 //!   [FREQUENCY=, TOTALS=NO, GLOBAL=]: S (at the integration points); `*NODE FILE`, `*EL FILE`
 //!   [FREQUENCY=, OUTPUT=, GLOBAL=]: U, S, RF (the fields of the VTU file).
 //!
-//! Step semantics as ccx's: supports and loads carry over from step to step; a repeated support or
-//! load on the same node and dof (face, for *DLOAD) replaces the earlier one; OP=NEW on the first
-//! *CLOAD (*DLOAD) of a step removes all earlier concentrated (distributed) loads. Set names are
-//! case-insensitive (kept upper-cased, as ccx prints them).
+//! Step semantics as ccx's (checked against ccx 2.20): supports and loads carry over from step to
+//! step; a load on a node and dof (face, for *DLOAD; element, for GRAV) given again within the same
+//! step adds to the first (two lines, two cards, or a node in two loaded sets), given in a later
+//! step it replaces the earlier step's value; a repeated support replaces the earlier one; OP=NEW on
+//! the first *CLOAD (*DLOAD) of a step removes all earlier concentrated (distributed) loads. The
+//! first *NODE PRINT (*EL PRINT, *NODE FILE, *EL FILE) of a step replaces the requests of that kind,
+//! and a step without one keeps the previous step's. Numbers must be finite (`nan`, `inf` and
+//! overflows are refused with their line). Set names are case-insensitive (kept upper-cased, as
+//! ccx prints them).
 
 use std::collections::{BTreeMap, HashMap};
 
@@ -49,6 +54,8 @@ pub struct Element {
     pub id: i64,
     /// Node indices (into [`Model::nodes`]), C3D10 order.
     pub nodes: Vec<usize>,
+    /// Line of the element's data.
+    pub line: usize,
 }
 
 /// A material.
@@ -69,6 +76,25 @@ pub struct Grav {
     pub g: f64,
     /// Direction (as given; ccx normalises it).
     pub dir: [f64; 3],
+}
+
+impl Grav {
+    /// The body force of `self` and `other` together (two GRAV lines on one element in a step).
+    pub fn plus(&self, other: &Grav) -> Grav {
+        let v: [f64; 3] = std::array::from_fn(|j| self.g * self.dir[j] + other.g * other.dir[j]);
+        let g = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        if g == 0.0 {
+            Grav {
+                g: 0.0,
+                dir: [0.0, 0.0, 1.0],
+            }
+        } else {
+            Grav {
+                g,
+                dir: v.map(|c| c / g),
+            }
+        }
+    }
 }
 
 /// A step's state: supports, loads (accumulated over the earlier steps) and output requests.

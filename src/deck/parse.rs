@@ -125,9 +125,19 @@ pub(super) fn num(path: &Path, d: &DataLine, k: usize, what: &str) -> Result<f64
         .get(k)
         .ok_or_else(|| error(path, d.line, format!("missing {what} (field {})", k + 1)))?;
     // Fortran-style exponents (1.0D+03) are accepted as ccx accepts them
+    // Rust's parser also reads "nan", "inf" and overflows to infinity: refused, as ccx would
+    // refuse them or carry them into the solution
     f.replace(['d', 'D'], "e")
-        .parse()
-        .map_err(|_| error(path, d.line, format!("{what}: '{f}' is not a number")))
+        .parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite())
+        .ok_or_else(|| {
+            error(
+                path,
+                d.line,
+                format!("{what}: '{f}' is not a finite number"),
+            )
+        })
 }
 
 pub(super) fn int(path: &Path, line: usize, f: &str, what: &str) -> Result<i64> {

@@ -136,20 +136,27 @@ fn ccx_order(s: &[f64; 6]) -> [f64; 6] {
 
 /// Solves every step of `model`.
 pub fn solve_model(model: &Model, options: SolveOptions) -> Result<DeckSolution> {
-    let (mesh, deck_node, mesh_of) = build_mesh(model)?;
+    let (mesh, deck_node, mesh_of, midsides) =
+        build_mesh(model).map_err(|e| with_deck_element(model, e))?;
     let (material, density) = element_materials(model)?;
     let mut steps = Vec::with_capacity(model.steps.len());
     for (k, step) in model.steps.iter().enumerate() {
-        steps.push(solve_step(
-            model,
-            &mesh,
-            &mesh_of,
-            material,
-            &density,
-            step,
-            k + 1,
-            options,
-        )?);
+        steps.push(
+            solve_step(
+                model,
+                &MeshOfDeck {
+                    mesh: &mesh,
+                    mesh_of: &mesh_of,
+                    midsides: &midsides,
+                },
+                material,
+                &density,
+                step,
+                k + 1,
+                options,
+            )
+            .map_err(|e| with_deck_element(model, e))?,
+        );
     }
     Ok(DeckSolution {
         mesh,
@@ -161,10 +168,47 @@ pub fn solve_model(model: &Model, options: SolveOptions) -> Result<DeckSolution>
     })
 }
 
-type MeshParts = (TetMesh, Vec<Option<usize>>, Vec<Option<usize>>);
+/// An element's error (an inverted element, midside nodes out of order) named by the deck's
+/// element id and line instead of its position.
+fn with_deck_element(model: &Model, e: FemError) -> FemError {
+    let element = match &e {
+        FemError::NegativeJacobian { element, .. } | FemError::MidsideNodeOrder { element, .. } => {
+            *element
+        }
+        _ => return e,
+    };
+    let Some(el) = model.elements.get(element) else {
+        return e;
+    };
+    let message = e.to_string();
+    let detail = message
+        .split_once(": ")
+        .map_or(message.as_str(), |(_, rest)| rest);
+    FemError::InvalidInput(format!("element {} (line {}): {detail}", el.id, el.line))
+}
+
+/// The added midside node of a C3D4 edge and the edge's two corners (mesh node indices).
+type Midside = (usize, usize, usize);
+
+type MeshParts = (
+    TetMesh,
+    Vec<Option<usize>>,
+    Vec<Option<usize>>,
+    Vec<Midside>,
+);
+
+/// The mesh a step is solved on and how its nodes relate to the deck's.
+struct MeshOfDeck<'a> {
+    mesh: &'a TetMesh,
+    /// Per deck node its mesh node.
+    mesh_of: &'a [Option<usize>],
+    /// The midside nodes added to C3D4 edges.
+    midsides: &'a [Midside],
+}
 
 /// The tet10 mesh: the deck nodes used by elements (file order), then added midside nodes of
-/// C3D4 edges. Returns the mesh, per mesh node its deck node, per deck node its mesh node.
+/// C3D4 edges. Returns the mesh, per mesh node its deck node, per deck node its mesh node, and the
+/// added midside nodes with their edges.
 fn build_mesh(model: &Model) -> Result<MeshParts> {
     let mut mesh_of: Vec<Option<usize>> = vec![None; model.nodes.len()];
     for e in &model.elements {
@@ -182,6 +226,7 @@ fn build_mesh(model: &Model) -> Result<MeshParts> {
         }
     }
     let mut edges: HashMap<(usize, usize), usize> = HashMap::new();
+    let mut midsides = Vec::new();
     let mut elements = Vec::with_capacity(model.elements.len());
     for e in &model.elements {
         let c = |a: usize| mesh_of[e.nodes[a]].expect("used");
@@ -197,6 +242,7 @@ fn build_mesh(model: &Model) -> Result<MeshParts> {
                         let (p, q) = (nodes[key.0], nodes[key.1]);
                         nodes.push(std::array::from_fn(|j| 0.5 * (p[j] + q[j])));
                         deck_node.push(None);
+                        midsides.push((nodes.len() - 1, key.0, key.1));
                         nodes.len() - 1
                     });
                 }
@@ -207,7 +253,7 @@ fn build_mesh(model: &Model) -> Result<MeshParts> {
         elements.push(el);
     }
     let mesh = TetMesh::new(nodes, elements)?;
-    Ok((mesh, deck_node, mesh_of))
+    Ok((mesh, deck_node, mesh_of, midsides))
 }
 
 /// The one elastic material of the sections, and each element's density.
@@ -259,23 +305,41 @@ fn element_materials(model: &Model) -> Result<(Material, Vec<Option<f64>>)> {
     Ok((material, density))
 }
 
-#[allow(clippy::too_many_arguments)]
+/// Largest relative residual ‖K u − f‖ / ‖f‖ of a step's solution: above it the supports leave
+/// a rigid-body motion free and the factorisation went through on round-off pivots.
+const MAX_RESIDUAL_REL: f64 = 1e-6;
+
 fn solve_step(
     model: &Model,
-    mesh: &TetMesh,
-    mesh_of: &[Option<usize>],
+    on: &MeshOfDeck<'_>,
     material: Material,
     density: &[Option<f64>],
     step: &Step,
     number: usize,
     options: SolveOptions,
 ) -> Result<StepResult> {
+    let MeshOfDeck {
+        mesh,
+        mesh_of,
+        midsides,
+    } = *on;
     let id = |n: usize| model.node_ids[n];
-    let prescribed: Vec<(usize, f64)> = step
+    let mut prescribed: Vec<(usize, f64)> = step
         .boundary
         .iter()
         .filter_map(|(&(n, dof), &v)| mesh_of[n].map(|m| (3 * m + dof, v)))
         .collect();
+    // A C3D4 edge is straight and its displacement linear (ccx's C3D4): the midside node added to
+    // an edge whose two corners are prescribed in a dof is prescribed at their mean in that dof,
+    // so that a support on a face holds the whole face
+    let given: HashMap<usize, f64> = prescribed.iter().copied().collect();
+    for &(m, a, b) in midsides {
+        for j in 0..3 {
+            if let (Some(va), Some(vb)) = (given.get(&(3 * a + j)), given.get(&(3 * b + j))) {
+                prescribed.push((3 * m + j, 0.5 * (va + vb)));
+            }
+        }
+    }
     let mut f = vec![0.0; mesh.n_dofs()];
     for (&(n, dof), &v) in &step.cloads {
         let m = mesh_of[n].ok_or_else(|| {
@@ -331,12 +395,30 @@ fn solve_step(
         quadrature: QuadratureChoice::Degree2,
     };
     let sol = solve_static(&problem)?;
+    if sol.residual_rel[0].is_nan() || sol.residual_rel[0] > MAX_RESIDUAL_REL {
+        return Err(FemError::InvalidInput(format!(
+            "step {number}: the solution does not satisfy K u = f (relative residual {:.1e}): the \
+             supports leave a rigid-body motion free (a mechanism); support the model against \
+             translation and rotation in all three directions (*BOUNDARY)",
+            sol.residual_rel[0]
+        )));
+    }
     let ts = Instant::now();
     let u = &sol.displacements[0];
     let stress = calculix_nodal_stress(mesh, &material, u, options.extrapolation)?;
     let mut timings = sol.timings;
     timings.stress_s = ts.elapsed().as_secs_f64();
-    let r = &sol.reactions[0];
+    // an added midside node's reaction goes half to each corner of its edge (the constraint
+    // u_m = (u_a + u_b) / 2 in virtual work), so that the deck's nodes carry every reaction
+    let mut r = sol.reactions[0].clone();
+    for &(m, a, b) in midsides {
+        for j in 0..3 {
+            let half = 0.5 * std::mem::take(&mut r[3 * m + j]);
+            r[3 * a + j] += half;
+            r[3 * b + j] += half;
+        }
+    }
+    let r = &r;
     let nn = model.nodes.len();
     let pick3 = |v: &[f64], n: usize| -> [f64; 3] {
         mesh_of[n].map_or([0.0; 3], |m| [v[3 * m], v[3 * m + 1], v[3 * m + 2]])
@@ -355,10 +437,17 @@ fn solve_step(
         }
         t
     };
-    let mut node_sets = BTreeMap::new();
+    // several requests on one set (U on one card, RF on another) print all their variables
+    let mut requests: BTreeMap<&String, (Vec<&String>, bool)> = BTreeMap::new();
     for (name, vars, totals) in &step.node_print {
+        let r = requests.entry(name).or_default();
+        r.0.extend(vars);
+        r.1 |= *totals;
+    }
+    let mut node_sets = BTreeMap::new();
+    for (name, (vars, totals)) in requests {
         let nodes = &model.nsets[name];
-        let has = |v: &str| vars.iter().any(|x| x == v);
+        let has = |v: &str| vars.iter().any(|x| *x == v);
         node_sets.insert(
             name.clone(),
             NodeSetOut {
@@ -366,7 +455,7 @@ fn solve_step(
                 u: has("U").then(|| nodes.iter().map(|&n| ud[n]).collect()),
                 s: has("S").then(|| nodes.iter().map(|&n| s[n]).collect()),
                 rf: has("RF").then(|| nodes.iter().map(|&n| rf[n]).collect()),
-                rf_total: (has("RF") && *totals).then(|| sum3(nodes)),
+                rf_total: (has("RF") && totals).then(|| sum3(nodes)),
             },
         );
     }
