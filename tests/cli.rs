@@ -182,6 +182,79 @@ fn free_run_with_the_energy_projection() {
 /// exceeds 10× its tolerance (10 s at atol 1e-9, rtol 0) is told, beside that warning, what keeps
 /// it on the energy integral; the projected run of the same settings meets its tolerance and is
 /// told nothing.
+/// What a new user may type into `dynamics free` and what comes back: a horizon whose output grid
+/// would not fit in memory and a relative tolerance of 1 are refused at once with what to give
+/// instead; a tolerance so loose that the run blows up warns; a picosecond run from rest gives no
+/// energy warning; `--max-steps` takes the help's own `1e6` form and raises the evaluation cap
+/// with it (genalpha at 1e-7 s needs more than the default 1e7 evaluations for 0.1 s); a run that
+/// hits the cap says what to raise.
+#[test]
+fn free_runs_refuse_what_cannot_work_and_say_what_to_try() {
+    let warnings = |o: &Output| -> Vec<String> {
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        v["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|w| w.as_str().unwrap().to_string())
+            .collect()
+    };
+    let t = std::time::Instant::now();
+    let o = rodstudy(&["dynamics", "free", "--t-end", "1e6"], &[]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("the longest run is 1000 s"),
+        "{err}"
+    );
+    assert!(
+        t.elapsed().as_secs_f64() < 5.0,
+        "refused before integrating"
+    );
+    let o = rodstudy(&["dynamics", "free", "--rtol", "1"], &[]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && err.contains("below 1"), "{err}");
+    let o = rodstudy(&["dynamics", "free", "--atol=1e308", "--json"], &[]);
+    assert!(
+        warnings(&o).iter().any(|w| w.contains("blew up")),
+        "{:?}",
+        warnings(&o)
+    );
+    let o = rodstudy(
+        &[
+            "dynamics", "free", "--method", "bdf", "--t-end", "1e-12", "--json",
+        ],
+        &[],
+    );
+    assert!(warnings(&o).is_empty(), "{:?}", warnings(&o));
+    let o = rodstudy(
+        &[
+            "dynamics",
+            "free",
+            "--method",
+            "dae-genalpha",
+            "--t-end",
+            "0.1",
+            "--dt",
+            "1e-7",
+            "--max-steps",
+            "1.1e6",
+            "--json",
+        ],
+        &[],
+    );
+    warnings(&o);
+    let o = rodstudy(
+        &["dynamics", "free", "--max-steps", "2", "--t-end", "0.01"],
+        &[],
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("raise --max-steps") && !err.contains("rk45: rk45:"),
+        "{err}"
+    );
+}
+
 #[test]
 fn a_drifting_rk45_run_is_pointed_to_the_energy_projection() {
     let run = |extra: &[&str]| {

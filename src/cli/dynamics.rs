@@ -90,8 +90,9 @@ pub struct FreeArgs {
     /// End time [s] (default 1).
     #[arg(long)]
     t_end: Option<f64>,
-    /// Cap on steps, in all (default: 1e6 per second of simulated time, at least 1e6).
-    #[arg(long)]
+    /// Cap on steps, in all (default: 1e6 per second of simulated time, at least 1e6); also
+    /// raises the cap on right-hand-side evaluations to 20 per step if that is more.
+    #[arg(long, value_parser = parse_count)]
     max_steps: Option<u64>,
     /// Print the result as JSON (without the trajectories).
     #[arg(long)]
@@ -138,6 +139,37 @@ struct ProjectionSummary {
     max_change_rad_s: f64,
 }
 
+/// What a user can do about a run that stopped, by why it stopped.
+fn what_to_try(e: &crate::free_run::FreeRunError) -> &'static str {
+    use crate::integrators::FailureKind as K;
+    let crate::free_run::FreeRunError::Solver(se) = e else {
+        return "";
+    };
+    match se.kind {
+        K::StepLimit { .. } | K::EvalLimit { .. } => {
+            ": raise --max-steps, or loosen --atol/--rtol (below the tolerance floor the step \
+             control fights round-off)"
+        }
+        K::StepSizeUnderflow { .. } => {
+            ": loosen --atol/--rtol (the step fell below what the time can resolve)"
+        }
+        K::NoConvergence { .. } | K::NonFinite => {
+            ": shorten --dt (fixed-step methods) or tighten --atol/--rtol"
+        }
+        _ => "",
+    }
+}
+
+/// A count given as an integer or in the help's own form (`1e6`).
+fn parse_count(v: &str) -> std::result::Result<u64, String> {
+    v.parse::<u64>().or_else(|_| match v.parse::<f64>() {
+        Ok(x) if x >= 0.0 && x.fract() == 0.0 && x <= u64::MAX as f64 => Ok(x as u64),
+        _ => Err(format!(
+            "'{v}' is not a whole number ≥ 0 (e.g. 5000000 or 5e6)"
+        )),
+    })
+}
+
 fn free(args: FreeArgs) -> Result<i32> {
     let method: FreeMethod = args.method.parse().map_err(|e| anyhow::anyhow!("{e}"))?;
     let mut options = FreeRunOptions::default();
@@ -149,17 +181,37 @@ fn free(args: FreeArgs) -> Result<i32> {
     options.fixed_step = args.dt.unwrap_or(options.fixed_step);
     // the default caps grow with the simulated time; an explicit --max-steps is a total
     options = options.with_caps_for_duration();
-    options.max_steps = args.max_steps.unwrap_or(options.max_steps);
+    if let Some(n) = args.max_steps {
+        options.max_steps = n;
+        options.max_rhs_evals = options.max_rhs_evals.max(n.saturating_mul(20));
+    }
     options.project_energy = args.project_energy;
-    let mut run = run_free(method, &options).map_err(|e| anyhow::anyhow!("{method}: {e}"))?;
+    let mut run = run_free(method, &options).map_err(|e| {
+        // the solver's own errors name the method already
+        let text = e.to_string();
+        let text = if text.starts_with(&format!("{method}:")) {
+            text
+        } else {
+            format!("{method}: {text}")
+        };
+        anyhow::anyhow!("{text}{}", what_to_try(&e))
+    })?;
     // the exact reference where the scene has one; warns when the error exceeds 10× the
     // tolerance
     let warnings_before = run.warnings.len();
-    let errors = options
-        .scene
-        .reference()
-        .ok()
-        .map(|reference| run.check_against_reference(&reference, &options));
+    let mut reference_failed = None;
+    let errors = match options.scene.reference() {
+        Ok(reference) => Some(run.check_against_reference(&reference, &options)),
+        Err(e) => {
+            reference_failed = options.scene.loads.is_conservative().then(|| {
+                format!(
+                    "the exact reference could not be built ({e}), so the run is not compared \
+                     with it (max_err_phi_rad and max_err_omega_rad_s are null)"
+                )
+            });
+            None
+        }
+    };
     // RK45 drifts off the energy integral of a conservative scene over a long run, and the phase
     // error follows the drift: say what keeps it there (docs/free-run.md)
     let warned = run.warnings.len() > warnings_before;
@@ -174,6 +226,7 @@ fn free(args: FreeArgs) -> Result<i32> {
                 .into(),
         );
     }
+    run.warnings.extend(reference_failed);
     let summary = FreeSummary {
         method: run.method.to_string(),
         model: run.model,

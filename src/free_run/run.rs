@@ -152,6 +152,10 @@ pub struct FreeRunResult {
 /// Relative energy drift above which a completed run gets a warning.
 pub const ENERGY_WARN_REL: f64 = 1e-3;
 
+/// Energy drift [J] below which no warning is given whatever its ratio to the kinetic energy
+/// (a run of a picosecond from rest has 1e-23 J of both).
+pub const ENERGY_WARN_FLOOR_J: f64 = 1e-9;
+
 /// A run whose error against the exact reference exceeds this multiple of its tolerance gets
 /// a warning ([`FreeRunResult::check_against_reference`]).
 pub const REFERENCE_WARN_FACTOR: f64 = 10.0;
@@ -299,8 +303,20 @@ pub fn run_free(method: Method, options: &FreeRunOptions) -> Result<FreeRunResul
         (None, None)
     };
     let mut warnings = Vec::new();
-    if let Some(rel) = energy_drift_rel
+    if energy_drift_max_j.is_some_and(|d| !d.is_finite())
+        || !phi.iter().chain(&omega).all(|v| v.is_finite())
+    {
+        warnings.push(format!(
+            "the solution is not finite (it blew up){}",
+            if method.is_fixed_step() {
+                ": the fixed step is too large"
+            } else {
+                ": the tolerance is too loose (--atol, --rtol)"
+            }
+        ));
+    } else if let Some(rel) = energy_drift_rel
         && rel > ENERGY_WARN_REL
+        && energy_drift_max_j.is_some_and(|d| d > ENERGY_WARN_FLOOR_J)
     {
         warnings.push(format!(
             "energy drift {:.3e} J is {:.1e} of the kinetic energy (> {ENERGY_WARN_REL:e}): the result is not accurate{}",

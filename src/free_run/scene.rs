@@ -27,6 +27,10 @@ pub struct FreeScene {
     pub dt_out: f64,
 }
 
+/// Most output points a run keeps (φ and φ̇ at each: 160 MB; 1,000 s of the scene's 1e-4 s grid,
+/// ten times the 100 s hard case).
+pub const MAX_OUTPUT_SAMPLES: usize = 10_000_000;
+
 impl Default for FreeScene {
     fn default() -> Self {
         Self::thesis()
@@ -87,8 +91,25 @@ impl FreeScene {
         Ok(ReducedModel::new(self.data)?)
     }
 
-    /// The output grid.
+    /// The output grid: refused when `t_end` is not after `t0`, or when it would hold more than
+    /// [`MAX_OUTPUT_SAMPLES`] points (the trajectories are kept in memory, 16 bytes a point).
     pub fn grid(&self) -> Result<OutputGrid, FreeRunError> {
+        if self.t_end.is_nan() || self.t_end <= self.t0 {
+            return Err(FreeRunError::Options(format!(
+                "the end time {} s must be after the start {} s (--t-end > 0)",
+                self.t_end, self.t0
+            )));
+        }
+        let samples = (self.t_end - self.t0) / self.dt_out;
+        if samples > MAX_OUTPUT_SAMPLES as f64 {
+            return Err(FreeRunError::Options(format!(
+                "--t-end {} s with an output every {} s is {samples:.2e} points, more than the \
+                 {MAX_OUTPUT_SAMPLES:.0e} kept in memory: the longest run is {} s",
+                self.t_end,
+                self.dt_out,
+                self.t0 + MAX_OUTPUT_SAMPLES as f64 * self.dt_out
+            )));
+        }
         OutputGrid::new(self.t0, self.t_end, self.dt_out).map_err(FreeRunError::Options)
     }
 

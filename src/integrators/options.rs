@@ -78,6 +78,18 @@ impl SolverOptions {
                 self.rtol, self.atol
             ));
         }
+        if self.rtol >= 1.0
+            || self
+                .rtol_components
+                .as_ref()
+                .is_some_and(|r| r.iter().any(|x| *x >= 1.0))
+        {
+            return Err(format!(
+                "rtol {} ≥ 1 controls nothing (an error as large as the solution passes): give a \
+                 relative tolerance below 1, e.g. 1e-6",
+                self.rtol
+            ));
+        }
         if self.rtol == 0.0 && self.atol == 0.0 && self.atol_components.is_none() {
             return Err("rtol and atol cannot both be zero".into());
         }

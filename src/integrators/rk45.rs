@@ -326,7 +326,7 @@ mod tests {
             let grid = OutputGrid::new(0.0, h, h / 2.0).unwrap();
             let opts = SolverOptions {
                 h: Some(h),
-                rtol: 1.0,
+                rtol: 0.5,
                 atol: 1.0,
                 ..Default::default()
             };
