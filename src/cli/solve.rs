@@ -41,7 +41,9 @@ pub fn run(args: SolveArgs) -> Result<i32> {
         ExtrapolationArg::Exact => Extrapolation::Exact,
         ExtrapolationArg::Calculix => Extrapolation::CalculiX,
     };
-    let sol = deck::solve_model(&model, SolveOptions { extrapolation })?;
+    // the solve's refusals (a mechanism, an inverted element) name the deck, as its read's do
+    let sol = deck::solve_model(&model, SolveOptions { extrapolation })
+        .map_err(|e| anyhow::anyhow!("{}: {e}", args.deck.display()))?;
     let stem = args
         .deck
         .file_stem()

@@ -184,7 +184,12 @@ fn with_deck_element(model: &Model, e: FemError) -> FemError {
     let detail = message
         .split_once(": ")
         .map_or(message.as_str(), |(_, rest)| rest);
-    FemError::InvalidInput(format!("element {} (line {}): {detail}", el.id, el.line))
+    FemError::InvalidInput(format!(
+        "element {} (line {}): {detail}; check the element's node order (corners 1-2-3 anticlockwise \
+         seen from corner 4, then the midside nodes \
+         of edges 1-2, 2-3, 3-1, 1-4, 2-4, 3-4) and its nodes' coordinates",
+        el.id, el.line
+    ))
 }
 
 /// The added midside node of a C3D4 edge and the edge's two corners (mesh node indices).
