@@ -214,6 +214,32 @@ fn free_runs_refuse_what_cannot_work_and_say_what_to_try() {
     let o = rodstudy(&["dynamics", "free", "--rtol", "1"], &[]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success() && err.contains("below 1"), "{err}");
+    // a flag the method would not read is refused, not ignored
+    let o = rodstudy(
+        &["dynamics", "free", "--method", "rk45", "--dt", "1e-4"],
+        &[],
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("rk45 chooses its own steps") && err.contains("--dt"),
+        "{err}"
+    );
+    let o = rodstudy(
+        &[
+            "dynamics",
+            "free",
+            "--method",
+            "initial-acceleration",
+            "--atol",
+            "1e-9",
+        ],
+        &[],
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("does not read --atol") && err.contains("--dt"),
+        "{err}"
+    );
     let o = rodstudy(&["dynamics", "free", "--atol=1e308", "--json"], &[]);
     assert!(
         warnings(&o).iter().any(|w| w.contains("blew up")),

@@ -48,6 +48,8 @@ fn index1_with_projection_gives_the_reduced_models_phi() {
     assert!(r.warnings.is_empty(), "{:?}", r.warnings);
     assert!(r.energy_drift_rel.unwrap() < 1e-10);
     assert!(r.steps > 100 && r.rhs_evals > 6 * r.steps && r.jac_evals == 0);
+    // every evaluation of c̈ solves the block system by one LU (eq. 3.38)
+    assert_eq!(r.lu_decompositions, r.rhs_evals);
     let json = serde_json::to_value(&r).unwrap();
     assert_eq!(json["method"], "dae-index1");
     assert!(json["constraint_drift_max"]["position"].as_f64().unwrap() < 1e-12);

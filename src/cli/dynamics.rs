@@ -78,13 +78,16 @@ pub struct FreeArgs {
     /// dae-genalpha (the 9-coordinate multibody DAE; genalpha's step is --dt).
     #[arg(long, default_value = "rk45")]
     method: String,
-    /// Relative tolerance (default 0: φ grows without bound, so control is absolute).
+    /// Relative tolerance (default 0: φ grows without bound, so control is absolute); the
+    /// fixed-step methods refuse it.
     #[arg(long)]
     rtol: Option<f64>,
-    /// Absolute tolerance on φ [rad] and φ̇ [rad/s] (default 1e-8).
+    /// Absolute tolerance on φ [rad] and φ̇ [rad/s] (default 1e-8); the fixed-step methods
+    /// refuse it.
     #[arg(long)]
     atol: Option<f64>,
-    /// Step of the fixed-step initial-acceleration method [s] (default 1e-5).
+    /// Step of the fixed-step methods, initial-acceleration and dae-genalpha [s] (default
+    /// 1e-5); the adaptive methods refuse it.
     #[arg(long)]
     dt: Option<f64>,
     /// End time [s] (default 1).
@@ -139,25 +142,56 @@ struct ProjectionSummary {
     max_change_rad_s: f64,
 }
 
-/// What a user can do about a run that stopped, by why it stopped.
-fn what_to_try(e: &crate::free_run::FreeRunError) -> &'static str {
+/// What a user can do about a run that stopped, by why it stopped and what the method reads.
+fn what_to_try(method: FreeMethod, e: &crate::free_run::FreeRunError) -> &'static str {
     use crate::integrators::FailureKind as K;
     let crate::free_run::FreeRunError::Solver(se) = e else {
         return "";
     };
-    match se.kind {
-        K::StepLimit { .. } | K::EvalLimit { .. } => {
+    match (&se.kind, method.is_fixed_step()) {
+        (K::StepLimit { .. } | K::EvalLimit { .. }, true) => {
+            ": raise --max-steps, or lengthen --dt"
+        }
+        (K::StepLimit { .. } | K::EvalLimit { .. }, false) => {
             ": raise --max-steps, or loosen --atol/--rtol (below the tolerance floor the step \
              control fights round-off)"
         }
-        K::StepSizeUnderflow { .. } => {
+        (K::StepSizeUnderflow { .. }, _) => {
             ": loosen --atol/--rtol (the step fell below what the time can resolve)"
         }
-        K::NoConvergence { .. } | K::NonFinite => {
-            ": shorten --dt (fixed-step methods) or tighten --atol/--rtol"
-        }
+        (K::NoConvergence { .. } | K::NonFinite, true) => ": shorten --dt",
+        (K::NoConvergence { .. } | K::NonFinite, false) => ": tighten --atol/--rtol",
         _ => "",
     }
+}
+
+/// A flag the chosen method would not read is refused rather than ignored: `--dt` belongs to
+/// the fixed-step methods (initial-acceleration, dae-genalpha), `--atol`/`--rtol` to the
+/// adaptive ones.
+fn refuse_flags_the_method_ignores(method: FreeMethod, args: &FreeArgs) -> Result<()> {
+    if method.is_fixed_step() {
+        let given: Vec<&str> = [
+            ("--atol", args.atol.is_some()),
+            ("--rtol", args.rtol.is_some()),
+        ]
+        .into_iter()
+        .filter_map(|(flag, set)| set.then_some(flag))
+        .collect();
+        if !given.is_empty() {
+            anyhow::bail!(
+                "{method} is a fixed-step method and does not read {}: its accuracy is set by \
+                 --dt (default 1e-5 s); for error control choose an adaptive method (rk45, rk23, \
+                 bdf, rosenbrock, trbdf2, dae-index1)",
+                given.join(" or ")
+            );
+        }
+    } else if args.dt.is_some() {
+        anyhow::bail!(
+            "{method} chooses its own steps from --atol/--rtol and does not read --dt: give \
+             --atol/--rtol, or a fixed-step method (initial-acceleration, dae-genalpha) for --dt"
+        );
+    }
+    Ok(())
 }
 
 /// A count given as an integer or in the help's own form (`1e6`).
@@ -172,6 +206,7 @@ fn parse_count(v: &str) -> std::result::Result<u64, String> {
 
 fn free(args: FreeArgs) -> Result<i32> {
     let method: FreeMethod = args.method.parse().map_err(|e| anyhow::anyhow!("{e}"))?;
+    refuse_flags_the_method_ignores(method, &args)?;
     let mut options = FreeRunOptions::default();
     if let Some(t_end) = args.t_end {
         options.scene.t_end = t_end;
@@ -194,7 +229,7 @@ fn free(args: FreeArgs) -> Result<i32> {
         } else {
             format!("{method}: {text}")
         };
-        anyhow::anyhow!("{text}{}", what_to_try(&e))
+        anyhow::anyhow!("{text}{}", what_to_try(method, &e))
     })?;
     // the exact reference where the scene has one; warns when the error exceeds 10× the
     // tolerance

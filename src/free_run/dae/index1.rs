@@ -10,7 +10,7 @@ use super::{Baumgarte, DaeOptions, DaeRun, Stabilization};
 use crate::integrators::{FailureKind, OdeSystem, OutputGrid, SolverOptions, StepProjection, rk45};
 use crate::mechanism::{DynamicsError, MultibodySystem};
 use nalgebra::{DVector, SVector};
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
 use std::time::Instant;
 
 /// The index-1 form as a first-order ODE of dimension 18.
@@ -22,6 +22,8 @@ pub struct Index1Ode<'a> {
     /// The first failure of the forward dynamics (the right-hand side then returns NaN,
     /// which makes the solver reject the step; if the solver gives up, this is the cause).
     pub failure: RefCell<Option<DynamicsError>>,
+    /// LU factorisations of the block system made (one per evaluation of the right-hand side).
+    pub lu_decompositions: Cell<u64>,
 }
 
 fn split(y: &DVector<f64>) -> (SVector<f64, 9>, SVector<f64, 9>) {
@@ -38,6 +40,7 @@ impl OdeSystem for Index1Ode<'_> {
 
     fn rhs(&self, t: f64, y: &DVector<f64>, dydt: &mut DVector<f64>) {
         let (q, qd) = split(y);
+        self.lu_decompositions.set(self.lu_decompositions.get() + 1);
         match self.system.forward_dynamics(&q, &qd, t, self.baumgarte) {
             Ok(f) => {
                 dydt.rows_mut(0, 9).copy_from(&qd);
@@ -136,6 +139,7 @@ pub(crate) fn run(
         system: &mb.system,
         baumgarte,
         failure: RefCell::new(None),
+        lu_decompositions: Cell::new(0),
     };
     let mut y0 = DVector::zeros(18);
     y0.rows_mut(0, 9).copy_from(&mb.q0);
@@ -155,7 +159,10 @@ pub(crate) fn run(
     };
     let cpu_s = start.elapsed().as_secs_f64();
     let sol = match sol {
-        Ok(s) => s,
+        Ok(mut s) => {
+            s.stats.lu_decompositions += ode.lu_decompositions.get();
+            s
+        }
         Err(e) => {
             // a step-size collapse caused by failing forward dynamics: report the cause
             let gave_up = matches!(
