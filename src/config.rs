@@ -489,6 +489,18 @@ impl StudyConfig {
                 bail!("`{key}` must be a positive number, got {v}");
             }
         }
+        let e = self.fem.youngs_modulus_pa;
+        if !(1e9..=1e12).contains(&e) {
+            bail!(
+                "`fem.youngs_modulus_pa` is in Pa and must lie between 1e9 and 1e12 (aluminium 7e10, \
+                 titanium 1.1e11, steel 2.1e11), got {e}{}",
+                if (1e3..1e6).contains(&e) {
+                    format!(": that looks like MPa, i.e. {:e} Pa", e * 1e6)
+                } else {
+                    String::new()
+                }
+            );
+        }
         let t = self.fem.target_error;
         if !(t.is_finite() && (0.0..1.0).contains(&t)) {
             bail!("`fem.target_error` must lie in [0, 1) (0: one fixed mesh), got {t}");
@@ -505,8 +517,27 @@ impl StudyConfig {
         if self.material.endurance_mpa >= self.material.ultimate_mpa {
             bail!("`material.endurance_mpa` must be below `material.ultimate_mpa`");
         }
-        if self.driven.steps == 0 {
-            bail!("`driven.steps` must be at least 1");
+        let max_steps = crate::mechanism::scene::MAX_STEPS;
+        if self.driven.steps == 0 || self.driven.steps > max_steps {
+            bail!(
+                "`driven.steps` must be between 1 and {max_steps}, got {}",
+                self.driven.steps
+            );
+        }
+        let f = &self.fem;
+        if !(f.min_size_mm <= f.max_size_mm
+            && f.step_min_size_mm <= f.max_size_mm
+            && f.initial_size_mm <= f.max_size_mm
+            && f.min_size_mm <= f.initial_size_mm)
+        {
+            bail!(
+                "the mesh sizes must be ordered `fem.min_size_mm` ({}) ≤ `fem.initial_size_mm` ({}) \
+                 ≤ `fem.max_size_mm` ({}), and `fem.step_min_size_mm` ({}) ≤ `fem.max_size_mm`",
+                f.min_size_mm,
+                f.initial_size_mm,
+                f.max_size_mm,
+                f.step_min_size_mm
+            );
         }
         let nu = self.fem.poisson_ratio;
         if !(nu.is_finite() && (-1.0..0.5).contains(&nu)) {

@@ -51,6 +51,9 @@ fn each_bad_design_is_reported_and_the_good_one_studied() {
     write(d, "wrong_type.toml", b"density = \"steel\"\n");
     write(d, "pins.stl", &good);
     write(d, "pins.toml", b"crank_pin = [40.0, 0.0, 0.0]\n");
+    // two designs whose reports would share a folder
+    write(d, "twin.stl", &good);
+    write(d, "twin.STL", &good);
 
     let o = Command::new(env!("CARGO_BIN_EXE_rodstudy"))
         .args([
@@ -93,6 +96,8 @@ fn each_bad_design_is_reported_and_the_good_one_studied() {
         ("typo.toml", "unknown field `unit`"),
         ("wrong_type.toml", "invalid type"),
         ("pins.stl", "crank pin (A)"),
+        ("twin.stl", "names the same report folder as"),
+        ("twin.STL", "names the same report folder as"),
     ];
     assert_eq!(failed.len(), expect.len(), "{failed:#?}");
     for (name, defect) in expect {
@@ -102,6 +107,7 @@ fn each_bad_design_is_reported_and_the_good_one_studied() {
         let f = hit.unwrap_or_else(|| panic!("no failure names {name}: {failed:#?}"));
         let e = f["error"].as_str().unwrap();
         assert!(e.contains(defect), "{name}: expected «{defect}» in «{e}»");
+        assert!(!e.contains('\n'), "one line: «{e}»");
     }
     for report in ["ranking.md", "mass_properties.csv", "index.html"] {
         let text = std::fs::read_to_string(out.path().join(report)).unwrap();

@@ -246,4 +246,20 @@ fn implausible_mass_is_warned_about() {
         "{:?}",
         d.warnings
     );
+    // the rod in metres read as millimetres, 1e-9 of its mass: not a rod in any units
+    let path = write(
+        dir.path(),
+        "metres.stl",
+        &binary_stl(&to_soup(&rod_mm().scaled(1e-3))),
+    );
+    write(
+        dir.path(),
+        "metres.toml",
+        b"piston_pin = [0.18, 0.0, 0.0]\n",
+    );
+    let e = format!("{:#}", mass_of_design(&path).unwrap_err());
+    assert!(
+        e.contains("metres.stl") && e.contains("cannot be a connecting rod's"),
+        "{e}"
+    );
 }

@@ -214,7 +214,12 @@ fn refused(name: &str, text: &[u8], line: usize, what: &str) {
     let err = read_volume_mesh_native(&path, "mm")
         .expect_err(name)
         .to_string();
-    let at = format!("{}:{line}:", path.display());
+    // a defect of the whole file (line 0) is named by the file alone
+    let at = if line > 0 {
+        format!("{}:{line}:", path.display())
+    } else {
+        format!("{}:", path.display())
+    };
     assert!(err.starts_with(&at), "{name}: expected '{at}…', got: {err}");
     assert!(err.contains(what), "{name}: expected '{what}' in: {err}");
 }
@@ -425,5 +430,68 @@ fn fem_no_buckling_leaves_out_buckling_and_nothing_else() {
         ] {
             assert_eq!(with[case][key], without[case][key], "{case}: {key}");
         }
+    }
+}
+
+/// A given mesh is refused, before any solve, when it is not a mesh of the design (another part:
+/// the volume differs) or when an element is inverted or has its midside nodes out of order;
+/// the element is named by its id and line in the file.
+#[test]
+fn a_given_mesh_of_another_part_or_with_a_bad_element_is_refused_by_name() {
+    let fem = |design: &str, mesh: &Path| {
+        let out_dir = tempfile::tempdir().unwrap();
+        let out = Command::new(env!("CARGO_BIN_EXE_rodstudy"))
+            .arg("fem")
+            .arg(root().join(design))
+            .arg("--mesh")
+            .arg(mesh)
+            .args(["--force", "7202", "--json", "--no-pictures", "--out"])
+            .arg(out_dir.path())
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2));
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let inp = meshes().join("quadratic.inp");
+    // design 1's mesh given for design 2 (3.90e5 against 4.79e5 mm³)
+    let e = fem("designs/design2.stl", &inp);
+    assert!(
+        e.contains("not a mesh of") && e.contains("differs by -18."),
+        "{e}"
+    );
+    // the first element turned inside out (corners 2 and 3 exchanged, with their edges), then
+    // instead two of its midside nodes exchanged
+    let text = std::fs::read_to_string(&inp).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let at = 1 + lines
+        .iter()
+        .position(|l| l.to_ascii_uppercase().starts_with("*ELEMENT"))
+        .unwrap();
+    let ids: Vec<&str> = lines[at].split(',').map(str::trim).collect();
+    assert_eq!(ids.len(), 11, "{}", lines[at]);
+    let dir = tempfile::tempdir().unwrap();
+    for (name, order, what) in [
+        (
+            "inverted.inp",
+            [0, 2, 1, 3, 6, 5, 4, 7, 9, 8],
+            "Jacobian determinant",
+        ),
+        (
+            "swapped.inp",
+            [0, 1, 2, 3, 5, 4, 6, 7, 8, 9],
+            "is not near the midpoint",
+        ),
+    ] {
+        let element: Vec<&str> = std::iter::once(ids[0])
+            .chain(order.iter().map(|&k| ids[1 + k]))
+            .collect();
+        let mut bad = lines.clone();
+        let joined = element.join(",");
+        bad[at] = &joined;
+        let path = dir.path().join(name);
+        std::fs::write(&path, bad.join("\n")).unwrap();
+        let e = fem("designs/design1.stl", &path);
+        let named = format!("{}:{}: element {}: ", path.display(), at + 1, ids[0]);
+        assert!(e.contains(&named) && e.contains(what), "{name}: {e}");
     }
 }

@@ -156,8 +156,19 @@ fn second_run_uses_the_cache_and_a_changed_design_reruns_alone() {
         designs.path().to_str().unwrap(),
         out.path().to_str().unwrap(),
     );
+    // files of stage 3 and the cycle that an earlier study left in a design's folder
+    let stale = out.path().join("a");
+    std::fs::create_dir_all(&stale).unwrap();
+    for f in ["fem_fx.vtu", "von_mises_fy.svg", "cycle.csv"] {
+        std::fs::write(stale.join(f), "from an earlier study").unwrap();
+    }
     let first = rodstudy(&["study", "--skip-fem", "--designs", d, "--out", o]);
     assert!(String::from_utf8_lossy(&first.stderr).contains("(0 from the cache)"));
+    // a study without stage 3 removes them: nothing in a design's folder disagrees with it
+    for f in ["fem_fx.vtu", "von_mises_fy.svg", "cycle.csv"] {
+        assert!(!stale.join(f).exists(), "{f} left behind");
+    }
+    assert!(stale.join("pin_force.csv").is_file());
     let second = rodstudy(&["study", "--skip-fem", "--designs", d, "--out", o]);
     assert!(String::from_utf8_lossy(&second.stderr).contains("(2 from the cache)"));
     std::fs::write(designs.path().join("b.toml"), "name = \"B renamed\"\n").unwrap();
@@ -182,6 +193,23 @@ fn second_run_uses_the_cache_and_a_changed_design_reruns_alone() {
     let again: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.path().join("results.json")).unwrap()).unwrap();
     assert_eq!(results, again);
+    // a study without stage 3 keeps its entries apart, so that it cannot replace a whole
+    // study's (whose FEM it would throw away)
+    let cache = out.path().join(".cache");
+    assert!(cache.join("without-fem").join("a.json").is_file());
+    assert!(!cache.join("a.json").exists());
+    // the same designs moved elsewhere: answered from the cache, under the files' new names
+    let moved = tempfile::tempdir().unwrap();
+    for f in ["a.stl", "b.stl", "b.toml"] {
+        std::fs::copy(designs.path().join(f), moved.path().join(f)).unwrap();
+    }
+    let m = moved.path().to_str().unwrap();
+    let fourth = rodstudy(&["study", "--skip-fem", "--designs", m, "--out", o]);
+    assert!(String::from_utf8_lossy(&fourth.stderr).contains("(2 from the cache)"));
+    let there: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.path().join("results.json")).unwrap()).unwrap();
+    let file = there["designs"][0]["mass"]["file"].as_str().unwrap();
+    assert!(file.starts_with(m), "{file} is not in {m}");
 }
 
 #[test]
@@ -244,6 +272,44 @@ fn configuration_file_sets_the_scene_and_typos_are_refused() {
         e.contains("settings.toml") && e.contains("unknown field `speed`"),
         "{e}"
     );
+    // settings no design can use are the configuration's error, before any design runs
+    for (text, says) in [
+        (
+            "[driven]\nsteps = 2000000\n",
+            "`driven.steps` must be between 1 and 1000000",
+        ),
+        ("[fem]\nyoungs_modulus_pa = 210000\n", "looks like MPa"),
+        (
+            "[fem]\nmin_size_mm = 20\nmax_size_mm = 2\ninitial_size_mm = 50\n",
+            "must be ordered",
+        ),
+    ] {
+        std::fs::write(&config, text).unwrap();
+        let bad = rodstudy(&[
+            "study",
+            "--skip-fem",
+            "--designs",
+            d,
+            "--out",
+            o,
+            "--config",
+            c,
+        ]);
+        let e = String::from_utf8_lossy(&bad.stderr);
+        assert!(
+            bad.status.code() == Some(2) && e.contains("settings.toml") && e.contains(says),
+            "{text}: {e}"
+        );
+    }
+    // a tolerance or a thread count that means nothing is a usage error
+    for args in [
+        &["check", "--rtol", "nan"][..],
+        &["check", "--rtol-mass=-1"][..],
+        &["study", "--jobs", "100000"][..],
+    ] {
+        let bad = rodstudy(args);
+        assert_eq!(bad.status.code(), Some(2), "{args:?}");
+    }
 }
 
 /// A design whose FEM stage fails (here: `RODSTUDY_PYTHON` names a program that is not Python, so

@@ -15,11 +15,11 @@ pub struct CheckArgs {
     /// The latest study results.
     #[arg(long, default_value = "reports/results.json")]
     results: PathBuf,
-    /// Relative tolerance on the peak pin force.
-    #[arg(long, default_value_t = DEFAULT_RTOL_FORCE)]
+    /// Relative tolerance on the peak pin force (a number ≥ 0).
+    #[arg(long, default_value_t = DEFAULT_RTOL_FORCE, value_parser = tolerance)]
     rtol: f64,
-    /// Relative tolerance on the mass.
-    #[arg(long, default_value_t = DEFAULT_RTOL_MASS)]
+    /// Relative tolerance on the mass (a number ≥ 0).
+    #[arg(long, default_value_t = DEFAULT_RTOL_MASS, value_parser = tolerance)]
     rtol_mass: f64,
     /// Print the rows as JSON.
     #[arg(long)]
@@ -49,4 +49,14 @@ pub fn run(args: CheckArgs) -> Result<i32> {
         args.baseline.display()
     );
     Ok(0)
+}
+
+/// A relative tolerance: a finite number ≥ 0.
+fn tolerance(v: &str) -> std::result::Result<f64, String> {
+    match v.parse::<f64>() {
+        Ok(x) if x.is_finite() && x >= 0.0 => Ok(x),
+        _ => Err(format!(
+            "'{v}' is not a relative tolerance (a finite number ≥ 0, e.g. 0.005)"
+        )),
+    }
 }

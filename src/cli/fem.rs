@@ -39,7 +39,7 @@ pub struct FemArgs {
     #[arg(long)]
     no_buckling: bool,
     /// Refinement study over these element sizes [mm] instead of one analysis, e.g. 8,5,3.5.
-    #[arg(long, value_delimiter = ',')]
+    #[arg(long, value_delimiter = ',', conflicts_with_all = ["mesh", "size", "target_error", "no_pictures", "no_buckling"])]
     refine: Option<Vec<f64>>,
     /// Speed against error: uniform meshes of `--sizes` and the adaptive sequence, each in its
     /// own process; writes convergence.md/.csv/.json/.svg into `--out`.
@@ -309,6 +309,9 @@ fn print_result(d: &DesignFem) {
         v.safety_factor,
         if v.pass { "pass" } else { "FAIL" }
     );
+    for note in &v.model_validity {
+        println!("model validity: {note}");
+    }
     for c in [&f.fx, &f.fy] {
         if let Some(vtu) = &c.vtu {
             eprintln!("wrote {}", vtu.display());

@@ -18,8 +18,8 @@ pub struct IntegratorsArgs {
     /// work_precision_evals.svg.
     #[arg(long, default_value = "reports")]
     out: PathBuf,
-    /// Repeats per run; the median CPU time is reported.
-    #[arg(long, default_value_t = 5)]
+    /// Repeats per run (at least 1); the median CPU time is reported.
+    #[arg(long, default_value_t = 5, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..))]
     repeats: usize,
     /// End time [s]. Other than 1: the long-horizon table (scene `free` run to T, output
     /// every 1e-4·T s, the reduced-model methods and RK45 with the energy projection,

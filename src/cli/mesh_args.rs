@@ -11,7 +11,7 @@ use std::path::PathBuf;
 pub struct MeshArgs {
     /// Use this ready volume mesh (gmsh .msh, Abaqus/CalculiX .inp, VTU, Nastran .bdf; tet10)
     /// as it is, instead of meshing the STL.
-    #[arg(long)]
+    #[arg(long, conflicts_with_all = ["size", "target_error"])]
     pub mesh: Option<PathBuf>,
     /// One fixed mesh of this element size [mm] (the thesis' setting is 5), instead of adaptive
     /// refinement.
@@ -36,6 +36,11 @@ impl MeshArgs {
             && !(t.is_finite() && t > 0.0 && t < 1.0)
         {
             bail!("--target-error must lie in (0, 1), got {t}");
+        }
+        if let Some(file) = &self.mesh
+            && !file.is_file()
+        {
+            bail!("{}: no such mesh file (--mesh)", file.display());
         }
         Ok(match (&self.mesh, self.size, self.target_error) {
             (Some(file), _, _) => MeshMode::User(file.clone()),

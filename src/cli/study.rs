@@ -26,8 +26,8 @@ pub struct StudyArgs {
     /// spec's defaults).
     #[arg(long)]
     config: Option<PathBuf>,
-    /// Designs studied at once (default: one per core).
-    #[arg(long, default_value_t = 0)]
+    /// Designs studied at once (default: one per core; at most 256).
+    #[arg(long, default_value_t = 0, value_parser = jobs)]
     jobs: usize,
     /// Leave out the FEM stage (mass and pin force only; no Python, no mesh).
     #[arg(long)]
@@ -146,4 +146,14 @@ pub fn run(args: StudyArgs) -> Result<i32> {
         );
     }
     Ok(i32::from(!results.failed.is_empty()))
+}
+
+/// `--jobs`: 0 (one per core) to 256 designs at once.
+fn jobs(v: &str) -> std::result::Result<usize, String> {
+    match v.parse::<usize>() {
+        Ok(n) if n <= 256 => Ok(n),
+        _ => Err(format!(
+            "'{v}' is not a number of designs at once from 0 (one per core) to 256"
+        )),
+    }
 }

@@ -308,7 +308,7 @@ pub fn find_bore(
         return Err(implausible(format!(
             "{} faces at radius {:.3} mm cover {:.1} mm² over an axial length of {:.3} mm: {:.1} % of a \
              full cylinder wall ({:.1} % over the length {:.3} mm that holds the middle 80 % of the area; expected \
-             {:.0}–{:.0} % for {what}); is the pin centre right (rod frame, mm)?",
+             {:.0}–{:.0} % for {what})",
             faces.len(),
             r_bore * 1e3,
             area_m2 * 1e6,

@@ -56,7 +56,7 @@ pub enum FemError {
         count: usize,
     },
     /// No bore surface found around a pin axis.
-    #[error("{role}: no bore found around the pin axis through ({:.3}, {:.3}, {:.3}) mm: {reason}",
+    #[error("{role}: no bore found around the pin axis through ({:.3}, {:.3}, {:.3}) mm: {reason} ({BORE_HINT})",
         centre_mm[0], centre_mm[1], centre_mm[2])]
     BoreNotFound {
         /// Which bore ("fixed small-end bore B" or "loaded big-end bore A").
@@ -67,7 +67,7 @@ pub enum FemError {
         reason: String,
     },
     /// A bore surface was found but it does not look like a whole cylinder wall.
-    #[error("{role}: implausible bore surface around ({:.3}, {:.3}, {:.3}) mm: {reason}",
+    #[error("{role}: implausible bore surface around ({:.3}, {:.3}, {:.3}) mm: {reason} ({BORE_HINT})",
         centre_mm[0], centre_mm[1], centre_mm[2])]
     ImplausibleBore {
         /// Which bore.
@@ -89,7 +89,7 @@ pub enum FemError {
         source: std::io::Error,
     },
     /// A mesh file that cannot be parsed.
-    #[error("{}:{line}: {message}", path.display())]
+    #[error("{}{}: {message}", path.display(), line_part(*line))]
     Parse {
         /// The file.
         path: PathBuf,
@@ -116,5 +116,19 @@ impl FemError {
             path: path.into(),
             source,
         }
+    }
+}
+
+/// What a bore that is not found, or not a cylinder wall, most often means.
+const BORE_HINT: &str = "check the pins (sidecar `crank_pin`/`piston_pin` in the design file's \
+     units, or found from the geometry) and the units (sidecar `units`; a given mesh is in the \
+     design's units and axes)";
+
+/// `:line` of a [`FemError::Parse`], nothing for a whole file (line 0).
+fn line_part(line: usize) -> String {
+    if line > 0 {
+        format!(":{line}")
+    } else {
+        String::new()
     }
 }

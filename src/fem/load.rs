@@ -229,9 +229,11 @@ pub fn cosine_pressure_with_resultant(
     let alpha = fmag * a22 / det;
     let beta = -fmag * a21 / det;
     if !(alpha > 0.0 && beta.abs() < alpha) {
-        return Err(FemError::Check(format!(
-            "the cosine bearing pressure would turn tensile (α {alpha:.3e}, β {beta:.3e}): the \
-             bore wall is too far from a half cylinder on the pressed side"
+        return Err(FemError::InvalidInput(format!(
+            "the cosine bearing pressure for the pin force along {d:.3?} would turn tensile (α \
+             {alpha:.3e}, β {beta:.3e}): the bore wall is too far from a half cylinder on the \
+             pressed side (a partial bore, e.g. a big end without its cap, open there); use \
+             bore_load = \"uniform\""
         )));
     }
     let forces: Vec<f64> = f1

@@ -392,6 +392,7 @@ pub fn solve_rod_static<'a>(
         }
     }
     let (loaded, fixed, axis, ex) = bores_and_direction(mesh, bores)?;
+    check_one_piece(mesh, &fixed.nodes)?;
     // y = axis × x, in the plane of motion
     let ey = cross(axis, ex);
     let cases = [("fx", ex, force_n), ("fy", ey, fy_force_n)];
@@ -710,4 +711,69 @@ pub fn rod_fx_case(mesh: &TetMesh, bores: &BoreSpec, force_n: f64) -> Result<Rod
         loaded,
         fixed,
     })
+}
+
+/// A rod's mesh must be one piece ([`super::mesh::pieces`]): a piece apart from the one that
+/// holds the fixed bore has no support (K singular), so it is refused by where it is and how
+/// large it is, not reported later as a failed pivot.
+fn check_one_piece(mesh: &TetMesh, fixed_nodes: &[usize]) -> Result<()> {
+    let (pieces, labels) = super::mesh::pieces::pieces(mesh);
+    if pieces.len() < 2 {
+        return Ok(());
+    }
+    let held = fixed_nodes.first().map_or(0, |&n| labels[n]);
+    let stray: Vec<String> = pieces
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| *k != held)
+        .take(3)
+        .map(|(_, p)| {
+            let c = p.centroid_m.map(|v| v * 1e3);
+            format!(
+                "{:.4e} mm³ ({} elements) around ({:.1}, {:.1}, {:.1}) mm",
+                p.volume_m3 * 1e9,
+                p.elements,
+                c[0],
+                c[1],
+                c[2]
+            )
+        })
+        .collect();
+    Err(FemError::InvalidInput(format!(
+        "the mesh is {} separate pieces, and only the one of {:.4e} mm³ holds the fixed bore: {} \
+         {} not connected to it (a separate body in the file, or a part that only touches the \
+         rod without sharing its surface) and would float; remove it, or join it to the rod",
+        pieces.len(),
+        pieces[held].volume_m3 * 1e9,
+        stray.join("; "),
+        if pieces.len() == 2 { "is" } else { "are" }
+    )))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::check_one_piece;
+    use crate::fem::TetMesh;
+    use crate::fem::mesh::structured::box_tet10;
+
+    #[test]
+    fn a_piece_apart_from_the_fixed_bores_is_refused_by_where_it_is() {
+        let a = box_tet10(0.1, 0.02, 0.02, 4, 1, 1).unwrap();
+        assert!(check_one_piece(&a, &[0]).is_ok());
+        let b = box_tet10(0.01, 0.01, 0.01, 1, 1, 1).unwrap();
+        let mut nodes = a.nodes().to_vec();
+        let n0 = nodes.len();
+        nodes.extend(b.nodes().iter().map(|p| [p[0] + 0.2, p[1], p[2]]));
+        let mut elements = a.elements().to_vec();
+        elements.extend(b.elements().iter().map(|el| el.map(|i| i + n0)));
+        let two = TetMesh::new(nodes, elements).unwrap();
+        let e = check_one_piece(&two, &[0]).unwrap_err().to_string();
+        assert!(
+            e.contains("2 separate pieces")
+                && e.contains("4.0000e4 mm³")
+                && e.contains("1.0000e3 mm³")
+                && e.contains("around (205.0, 5.0, 5.0) mm"),
+            "{e}"
+        );
+    }
 }

@@ -32,6 +32,12 @@ use std::path::{Path, PathBuf};
 /// Plausible mass range of a connecting rod [kg]; outside it the units are probably wrong.
 pub const PLAUSIBLE_MASS_KG: (f64, f64) = (0.01, 100.0);
 
+/// The mass range outside which a rod's stage 1 refuses the design [kg]: a millimetre file read
+/// as metres weighs 1e9 times its mass (and a metre file read as mm 1e-9 times), so a rod from
+/// a 10 g model to a 1000 kg marine rod lands outside it in the wrong units, and a scale model of
+/// a few milligrams or a rod of tonnes inside it in the right ones.
+pub const REFUSED_MASS_KG: (f64, f64) = (1e-6, 1e5);
+
 /// A design loaded and validated: its settings, its surface in metres and its mass properties.
 pub struct LoadedDesign {
     pub name: String,
@@ -328,6 +334,17 @@ struct PinBore {
 /// The bore check and the mechanism frame of a loaded design.
 fn rod_record(d: &LoadedDesign, stl: &Path) -> Result<DesignMass> {
     let file = || stl.display().to_string();
+    let (lo, hi) = REFUSED_MASS_KG;
+    if !(lo..=hi).contains(&d.mass.mass) {
+        bail!(
+            "{}: mass {:.4e} kg cannot be a connecting rod's ({lo:e}–{hi:e} kg): the units are \
+             wrong (sidecar `units`, now {}; a millimetre file read as metres weighs 1e9 times \
+             as much)",
+            stl.display(),
+            d.mass.mass,
+            d.settings.units.symbol()
+        );
+    }
     if let Some(e) = &d.pins.search_error
         && !matches!(e, PinSearchError::NoBore(_))
     {

@@ -36,7 +36,7 @@
 use std::collections::HashMap;
 use std::path::Path;
 
-use super::raw_volume::RawVolume;
+use super::raw_volume::{FileLabel, RawVolume};
 use crate::fem::error::{FemError, Result};
 
 /// Keywords carrying mesh data that are not read natively.
@@ -171,6 +171,7 @@ pub fn read_inp(path: &Path) -> Result<RawVolume> {
                     return Err(perr(ln, format!("node {id} defined twice")));
                 }
                 raw.nodes.push(p);
+                raw.node_labels.push(FileLabel { id, line: ln });
             }
             Block::Elements(Some(quadratic), n) => {
                 let tokens: Vec<&str> = t
@@ -202,6 +203,10 @@ pub fn read_inp(path: &Path) -> Result<RawVolume> {
                         } else {
                             raw.tet4.push(std::array::from_fn(node));
                         }
+                        raw.tet_labels.push(FileLabel {
+                            id: pending[0],
+                            line: pending_line,
+                        });
                         pending.clear();
                         // an element ends with its line (it may span lines, not share one)
                         if k + 1 < tokens.len() {

@@ -25,7 +25,7 @@ use std::path::Path;
 
 use mshio::mshfile::ElementType;
 
-use super::raw_volume::RawVolume;
+use super::raw_volume::{FileLabel, RawVolume};
 use crate::fem::error::{FemError, Result};
 
 /// gmsh's 10-node tetrahedron → VTK's: swap the midside nodes 8 and 9.
@@ -207,6 +207,10 @@ pub fn read_msh(path: &Path) -> Result<RawVolume> {
                         t[a] = index(tag).ok_or_else(|| unknown(tag, el.element_tag))?;
                     }
                     raw.tet10.push(t);
+                    raw.tet_labels.push(FileLabel {
+                        id: el.element_tag as i64,
+                        line: 0,
+                    });
                 }
             }
             ElementType::Tet4 => {
@@ -216,6 +220,10 @@ pub fn read_msh(path: &Path) -> Result<RawVolume> {
                         t[a] = index(tag).ok_or_else(|| unknown(tag, el.element_tag))?;
                     }
                     raw.tet4.push(t);
+                    raw.tet_labels.push(FileLabel {
+                        id: el.element_tag as i64,
+                        line: 0,
+                    });
                 }
             }
             other => raw.dropped.push(format!("{other:?}")),

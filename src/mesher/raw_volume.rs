@@ -30,6 +30,28 @@ pub struct RawVolume {
     pub tet4: Vec<[usize; 4]>,
     /// Kinds of elements dropped (surface, line, point elements), for messages.
     pub dropped: Vec<String>,
+    /// The file's id and line of each node (parallel to `nodes`; empty when the reader does not
+    /// know them), for messages.
+    pub node_labels: Vec<FileLabel>,
+    /// The file's id and line of each tetrahedron (parallel to `tet10`, or to `tet4`).
+    pub tet_labels: Vec<FileLabel>,
+}
+
+/// Where an entity of a mesh file is: its id in the file and its 1-based line (0: not known,
+/// e.g. in a gmsh file read by mshio).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FileLabel {
+    pub id: i64,
+    pub line: usize,
+}
+
+/// `what` `k` of a file by its id in the file, else by its place in the file (1-based); the
+/// line, where known, goes before the message (`file:line: …`).
+fn describe(labels: &[FileLabel], k: usize, what: &str) -> String {
+    labels.get(k).map_or_else(
+        || format!("the {}. {what} of the file", k + 1),
+        |l| format!("{what} {}", l.id),
+    )
 }
 
 /// VTK tetra10 edges, in the order of the midside nodes 4..9 (the same table as `mesh_rod.py`).
@@ -60,7 +82,20 @@ impl RawVolume {
             tet10,
             tet4,
             dropped,
+            node_labels,
+            tet_labels,
         } = self;
+        if let Some(k) = nodes.iter().position(|p| !p.iter().all(|v| v.is_finite())) {
+            return Err(FemError::Parse {
+                path: path.to_path_buf(),
+                line: node_labels.get(k).map_or(0, |l| l.line),
+                message: format!(
+                    "{} has a non-finite coordinate {:?}",
+                    describe(&node_labels, k, "node"),
+                    nodes[k]
+                ),
+            });
+        }
         let tets: Vec<[usize; 10]> = match (tet10.is_empty(), tet4.is_empty()) {
             (false, false) => {
                 return Err(whole(
@@ -98,8 +133,69 @@ impl RawVolume {
                 kept.push([p[0] * scale, p[1] * scale, p[2] * scale]);
             }
         }
-        let elements = tets.into_iter().map(|el| el.map(|n| remap[n])).collect();
-        TetMesh::new(kept, elements).map_err(|e| whole(e.to_string()))
+        let elements = tets.iter().map(|el| el.map(|n| remap[n])).collect();
+        TetMesh::new(kept, elements).map_err(|e| match e {
+            FemError::MidsideNodeOrder {
+                element,
+                local,
+                edge: [a, b],
+                ..
+            } => FemError::Parse {
+                path: path.to_path_buf(),
+                line: tet_labels.get(element).map_or(0, |l| l.line),
+                message: format!(
+                    "{}: its node {} ({}) is not near the midpoint of the edge between its \
+                     corners {} and {}: the nodes are not in the order VTK and CalculiX use \
+                     (corners 1-4, then the midside nodes of edges 1-2, 2-3, 3-1, 1-4, 2-4, \
+                     3-4), or the mesh is corrupt",
+                    describe(&tet_labels, element, "element"),
+                    local + 1,
+                    describe(&node_labels, tets[element][local], "node"),
+                    a + 1,
+                    b + 1
+                ),
+            },
+            e => whole(e.to_string()),
+        })
+    }
+
+    /// [`RawVolume::finish`] for a mesh a user gives: also checks every element's Jacobian (as
+    /// the assembly would, later and without the file's ids), and names a bad element by the
+    /// file's id and line.
+    pub fn finish_checked(self, path: &Path, scale: f64) -> Result<TetMesh> {
+        let labels = self.tet_labels.clone();
+        let mesh = self.finish(path, scale)?;
+        check_elements(&mesh, path, &labels)?;
+        Ok(mesh)
+    }
+}
+
+/// Checks det J > 0 at every element's quadrature points and nodes ([`TetMesh::check_jacobians`]),
+/// naming a bad element by `labels` (the file's ids and lines; empty: by its place in the file).
+pub fn check_elements(mesh: &TetMesh, path: &Path, labels: &[FileLabel]) -> Result<()> {
+    mesh.check_jacobians(crate::fem::QuadratureChoice::Auto)
+        .map(|_| ())
+        .map_err(|e| name_element(path, labels, e))
+}
+
+/// An element's error with the element named as the file names it.
+fn name_element(path: &Path, labels: &[FileLabel], e: FemError) -> FemError {
+    let FemError::NegativeJacobian { element, .. } = e else {
+        return e;
+    };
+    let message = e.to_string();
+    let detail = message
+        .split_once(": ")
+        .map_or(message.as_str(), |(_, rest)| rest);
+    FemError::Parse {
+        path: path.to_path_buf(),
+        line: labels.get(element).map_or(0, |l| l.line),
+        message: format!(
+            "{}: {detail}; check its node order (VTK/CalculiX: corners 1-2-3 anticlockwise seen \
+             from corner 4, then the midside nodes of edges 1-2, 2-3, 3-1, 1-4, 2-4, 3-4) and its \
+             nodes' coordinates",
+            describe(labels, element, "element")
+        ),
     }
 }
 

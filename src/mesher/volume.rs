@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use super::gmsh::convert_mesh;
-use super::raw_volume::unit_scale;
+use super::raw_volume::{RawVolume, unit_scale};
 use crate::fem::TetMesh;
 use crate::fem::error::{FemError, Result};
 
@@ -59,21 +59,23 @@ pub fn volume_reader(path: &Path) -> Result<VolumeReader> {
 /// the file's numbers in `units` ("mm" or "m"), into a mesh in metres.
 pub fn read_volume_mesh_native(path: &Path, units: &str) -> Result<TetMesh> {
     let scale = unit_scale(units)?;
+    read_raw_native(path)?.finish(path, scale)
+}
+
+/// The tetrahedra of a gmsh MSH 4.1 or `.inp` file as read, before they are finished.
+fn read_raw_native(path: &Path) -> Result<RawVolume> {
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
-    let raw = match ext.as_str() {
-        "msh" => super::msh::read_msh(path)?,
-        "inp" => super::inp::read_inp(path)?,
-        _ => {
-            return Err(FemError::InvalidInput(format!(
-                "{}: not read natively (only gmsh MSH 4.1 and Abaqus/CalculiX .inp are)",
-                path.display()
-            )));
-        }
-    };
-    raw.finish(path, scale)
+    match ext.as_str() {
+        "msh" => super::msh::read_msh(path),
+        "inp" => super::inp::read_inp(path),
+        _ => Err(FemError::InvalidInput(format!(
+            "{}: not read natively (only gmsh MSH 4.1 and Abaqus/CalculiX .inp are)",
+            path.display()
+        ))),
+    }
 }
 
 /// Reads a binary gmsh MSH 4.1 file that the pipeline wrote in place of an ASCII one
@@ -118,9 +120,13 @@ pub fn read_volume_mesh(
     }
     let reader = volume_reader(path)?;
     if reader != VolumeReader::Meshio {
-        return Ok((read_volume_mesh_native(path, units)?, reader));
+        let scale = unit_scale(units)?;
+        let raw = read_raw_native(path)?;
+        return Ok((raw.finish_checked(path, scale)?, reader));
     }
-    Ok((read_volume_mesh_meshio(path, units, work_dir)?, reader))
+    let mesh = read_volume_mesh_meshio(path, units, work_dir)?;
+    super::raw_volume::check_elements(&mesh, path, &[])?;
+    Ok((mesh, reader))
 }
 
 /// Reads `path` through meshio (`pipeline/mesh_rod.py convert`, writing

@@ -52,8 +52,24 @@ pub fn load_span(with_gas: bool) -> &'static str {
 }
 
 /// One design's pin force over the first revolution (the four-stroke cycle with a gas force):
-/// |F_A| and its components.
-pub fn design_pin_force_plot(design: &str, h: &DrivenResult) -> Result<String> {
+/// The driven scene of a study as the plots' titles name it: "φ = 40πt, gravity on" for the
+/// spec's scene.
+pub fn scene_label(config: &crate::config::StudyConfig) -> String {
+    let w = config.driven.omega_rad_s;
+    let per_pi = w / std::f64::consts::PI;
+    let speed = if (per_pi - per_pi.round()).abs() < 1e-9 * per_pi.abs().max(1.0) {
+        format!("{}πt", per_pi.round())
+    } else {
+        format!("{w:.4} t")
+    };
+    format!(
+        "φ = {speed}, gravity {}",
+        if config.driven.gravity { "on" } else { "off" }
+    )
+}
+
+/// |F_A| and its components; `scene` from [`scene_label`].
+pub fn design_pin_force_plot(design: &str, h: &DrivenResult, scene: &str) -> Result<String> {
     let series = vec![
         plots::Series {
             name: "|F_A|".into(),
@@ -69,7 +85,7 @@ pub fn design_pin_force_plot(design: &str, h: &DrivenResult) -> Result<String> {
         },
     ];
     plots::line_chart(
-        &format!("{design}: crank–rod pin force (φ = 40πt, gravity on)"),
+        &format!("{design}: crank–rod pin force ({scene})"),
         "crank angle φ [°] (0 = top dead centre)",
         "force by the crank on the rod at A [N] (global frame)",
         &series,
@@ -79,7 +95,10 @@ pub fn design_pin_force_plot(design: &str, h: &DrivenResult) -> Result<String> {
 }
 
 /// |F_A| over the first crank revolution, all designs in one plot.
-pub fn pin_force_plot(histories: &[(String, String, &DrivenResult)]) -> Result<String> {
+pub fn pin_force_plot(
+    histories: &[(String, String, &DrivenResult)],
+    scene: &str,
+) -> Result<String> {
     let series: Vec<plots::Series> = histories
         .iter()
         .map(|(_, design, h)| plots::Series {
@@ -89,10 +108,7 @@ pub fn pin_force_plot(histories: &[(String, String, &DrivenResult)]) -> Result<S
         .collect();
     let with_gas = histories.iter().any(|(_, _, h)| h.gas_force_n.is_some());
     plots::line_chart(
-        &format!(
-            "Crank–rod pin force over {} (φ = 40πt, gravity on)",
-            load_span(with_gas)
-        ),
+        &format!("Crank–rod pin force over {} ({scene})", load_span(with_gas)),
         "crank angle φ [°] (0 = top dead centre)",
         "|F_A| [N]",
         &series,
@@ -234,4 +250,21 @@ struct HistoryRowGas<'a> {
     fb_abs_n: f64,
     crank_torque_nm: f64,
     gas_force_n: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::scene_label;
+    use crate::config::StudyConfig;
+
+    #[test]
+    fn the_plots_name_the_studys_scene() {
+        let mut c = StudyConfig::default();
+        assert_eq!(scene_label(&c), "φ = 40πt, gravity on");
+        c.driven.omega_rad_s = 20.0 * std::f64::consts::PI;
+        c.driven.gravity = false;
+        assert_eq!(scene_label(&c), "φ = 20πt, gravity off");
+        c.driven.omega_rad_s = 100.0;
+        assert_eq!(scene_label(&c), "φ = 100.0000 t, gravity off");
+    }
 }

@@ -73,6 +73,7 @@ pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>>
         }
     }
     let histories = design_files::histories(results);
+    let scene = design_files::scene_label(&results.config);
     for (id, design, h) in &histories {
         let dir = out.join(file_safe(id));
         let path = dir.join("pin_force.csv");
@@ -80,7 +81,7 @@ pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>>
         let plot = dir.join("pin_force.svg");
         write_atomic(
             &plot,
-            design_files::design_pin_force_plot(design, h)?.as_bytes(),
+            design_files::design_pin_force_plot(design, h, &scene)?.as_bytes(),
         )?;
         written.extend([path, plot]);
     }
@@ -99,7 +100,10 @@ pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>>
     }
     if !histories.is_empty() {
         let pin = out.join("pin_force.svg");
-        write_atomic(&pin, design_files::pin_force_plot(&histories)?.as_bytes())?;
+        write_atomic(
+            &pin,
+            design_files::pin_force_plot(&histories, &scene)?.as_bytes(),
+        )?;
         let bars = out.join("peak_force.svg");
         let peaks: Vec<(String, f64)> = ranking::ranking(results)
             .iter()
@@ -108,7 +112,7 @@ pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>>
         write_atomic(
             &bars,
             plots::bar_chart(
-                "Peak crank–rod pin force (φ = 40πt, gravity on)",
+                &format!("Peak crank–rod pin force ({scene})"),
                 "peak |F_A| [N]",
                 &peaks,
             )?
@@ -152,5 +156,47 @@ pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>>
     let index = out.join("index.html");
     write_atomic(&index, index_page::index_html(results, out).as_bytes())?;
     written.push(index);
+    remove_stale_stage_files(results, out)?;
     Ok(written)
+}
+
+/// The files stage 3 and the cycle write into a design's folder (`fields`, and the cycle's table
+/// and plot above).
+const FEM_FILES: [&str; 4] = [
+    "fem_fx.vtu",
+    "fem_fy.vtu",
+    "von_mises_fx.svg",
+    "von_mises_fy.svg",
+];
+const CYCLE_FILES: [&str; 4] = ["cycle.vtu", "von_mises_cycle.svg", "cycle.csv", "cycle.svg"];
+
+/// Removes, from the folder of each design this study reports, the stage files of a stage it
+/// did not run or that failed (left by an earlier study, e.g. before a `--skip-fem` one), so that
+/// no file in a design's folder disagrees with `results.json`.
+fn remove_stale_stage_files(results: &StudyResults, out: &Path) -> Result<()> {
+    let designs = results
+        .designs
+        .iter()
+        .map(|d| (d.mass.id.clone(), d.fem.is_some(), d.cycle.is_some()));
+    let failed = results.failed.iter().map(|f| (f.id(), false, false));
+    for (id, fem, cycle) in designs.chain(failed) {
+        let dir = out.join(file_safe(&id));
+        let stale = (!fem)
+            .then_some(&FEM_FILES[..])
+            .into_iter()
+            .chain((!cycle).then_some(&CYCLE_FILES[..]))
+            .flatten();
+        for name in stale {
+            match std::fs::remove_file(dir.join(name)) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                    return Err(anyhow::Error::new(e).context(format!(
+                        "{}: cannot remove a stale file",
+                        dir.join(name).display()
+                    )));
+                }
+                _ => {}
+            }
+        }
+    }
+    Ok(())
 }

@@ -572,6 +572,7 @@ pub fn fem_fixed(
     buckling_n: Option<f64>,
 ) -> Result<FemOutcome> {
     let setup = Setup::new(design, config, true, keep_system)?;
+    setup.check_uniform_size(design, size_mm)?;
     let mut mesher = setup.mesher(work_dir)?;
     let meshed = mesher
         .fixed(size_mm)
@@ -617,6 +618,7 @@ pub fn fem_adaptive(
     buckling_n: Option<f64>,
 ) -> Result<FemOutcome> {
     let setup = Setup::new(design, config, true, keep_system)?;
+    setup.check_uniform_size(design, settings.initial_size_mm)?;
     let mut mesher = setup.mesher(work_dir)?;
     let facets = FacetScale::from_edges(setup.edges(), &setup.surface.vertices, 2.0);
     // an STL's facets set a floor below which refinement resolves the facets, not the part; the
@@ -716,8 +718,15 @@ pub fn fem_user_mesh(
         (setup, read)
     });
     let mut setup = setup?;
-    let (read, read_time) =
-        read.with_context(|| format!("{}: cannot use this volume mesh", file.display()))?;
+    // the reader's errors mostly start with the file's name already
+    let (read, read_time) = read.map_err(|e| {
+        let (name, m) = (file.display().to_string(), e.to_string());
+        if m.starts_with(&name) {
+            anyhow::anyhow!("cannot use this volume mesh: {m}")
+        } else {
+            anyhow::anyhow!("{name}: cannot use this volume mesh: {m}")
+        }
+    })?;
     let start = std::time::Instant::now();
     // the file's numbers were read as mm (×1e-3); the file is in the design's units
     let f = setup.surface.frame;
@@ -728,6 +737,13 @@ pub fn fem_user_mesh(
             [q.dot(&f.x), q.dot(&f.y), q.dot(&f.z)]
         })
         .with_context(|| format!("{}: the mesh in the rod frame", file.display()))?;
+    check_mesh_is_the_designs(&mesh, &setup.surface).with_context(|| {
+        format!(
+            "{}: not a mesh of {}",
+            file.display(),
+            design.file.display()
+        )
+    })?;
     // reading and moving the mesh, not the analysis (fem.total_s)
     let mesh_seconds = (read_time + start.elapsed()).as_secs_f64();
     // the surface's sharp edges matter only to the stresses' post-processing: worked out while K
@@ -757,6 +773,97 @@ pub fn fem_user_mesh(
     Ok(setup.outcome(force_n, config, summary, mesh, solution))
 }
 
+/// How far a given mesh's volume may lie from the design's (relative): a straight-sided tet10
+/// mesh of a rod at 8 mm loses well under 1 % on its bores' chords, gmsh's meshes of the
+/// designs 0.02–0.08 %.
+pub const USER_MESH_VOLUME_TOLERANCE: f64 = 0.02;
+
+/// How far a given mesh's bounding box may lie from the design's, as a fraction of the centre
+/// distance A→B.
+pub const USER_MESH_EXTENT_TOLERANCE: f64 = 0.02;
+
+/// A given mesh must be a mesh of the design it is analysed as: the same volume (within
+/// [`USER_MESH_VOLUME_TOLERANCE`]) and the same extent in the rod frame (within
+/// [`USER_MESH_EXTENT_TOLERANCE`] of l), or the loads and supports (placed from the design's
+/// pins) would land on another part, in other units or in another pose.
+fn check_mesh_is_the_designs(mesh: &TetMesh, surface: &RodFrameSurface) -> Result<()> {
+    let mesh_mm3 = crate::fem::body_force::mesh_mass_properties(mesh, 1.0).volume_m3 * 1e9;
+    let design_mm3 = surface.volume_mm3();
+    let rel = (mesh_mm3 - design_mm3) / design_mm3;
+    if rel.is_nan() || rel.abs() > USER_MESH_VOLUME_TOLERANCE {
+        anyhow::bail!(
+            "the mesh's volume, {mesh_mm3:.6e} mm³, differs by {:+.1} % from the design's, \
+             {design_mm3:.6e} mm³ (more than {:.0} %): give a mesh of this design, in the design's \
+             units (sidecar `units`) and its file's axes",
+            100.0 * rel,
+            100.0 * USER_MESH_VOLUME_TOLERANCE
+        );
+    }
+    let (lo, hi) = mesh.bounding_box();
+    let (mut dlo, mut dhi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for v in &surface.vertices {
+        for k in 0..3 {
+            dlo[k] = dlo[k].min(v[k]);
+            dhi[k] = dhi[k].max(v[k]);
+        }
+    }
+    let worst = (0..3)
+        .flat_map(|k| [(lo[k] * 1e3 - dlo[k]).abs(), (hi[k] * 1e3 - dhi[k]).abs()])
+        .fold(0.0, f64::max);
+    let allowed = USER_MESH_EXTENT_TOLERANCE * surface.centre_distance_mm;
+    if worst.is_nan() || worst > allowed {
+        let fmt = |l: [f64; 3], h: [f64; 3], s: f64| {
+            format!(
+                "x {:.1}…{:.1}, y {:.1}…{:.1}, z {:.1}…{:.1} mm",
+                l[0] * s,
+                h[0] * s,
+                l[1] * s,
+                h[1] * s,
+                l[2] * s,
+                h[2] * s
+            )
+        };
+        anyhow::bail!(
+            "the mesh spans {} in the rod frame, the design {} (a corner {worst:.1} mm off, more \
+             than {allowed:.1} mm): give the mesh in the design file's axes and units",
+            fmt(lo, hi, 1e3),
+            fmt(dlo, dhi, 1.0)
+        );
+    }
+    Ok(())
+}
+
+/// DOFs of a uniform gmsh tet10 mesh per (volume / size³): 35.6 on design 1 at 5 mm (111,150 DOFs,
+/// 3.90e5 mm³), 39 on design 5 (99,285, 3.18e5 mm³); the guard below takes 30, an estimate
+/// from below.
+const UNIFORM_MESH_DOFS_PER_CELL: f64 = 30.0;
+
+/// The largest uniform mesh stage 3 starts: about what a direct solve's factor holds in this
+/// machine's memory (design 1 at 2 mm, about 1.7 M DOFs, factorises in a few GB).
+pub const UNIFORM_MESH_MAX_DOFS: f64 = 5e6;
+
+impl Setup {
+    /// Refuses, before gmsh starts, a uniform mesh of `size_mm` that would be far beyond what can
+    /// be solved: a size meant for another part, or a design read in the wrong units (a
+    /// millimetre rod read as metres is 1e9 times its volume).
+    fn check_uniform_size(&self, design: &LoadedDesign, size_mm: f64) -> Result<()> {
+        let v = self.surface.volume_mm3();
+        let dofs = UNIFORM_MESH_DOFS_PER_CELL * v / size_mm.powi(3);
+        if dofs > UNIFORM_MESH_MAX_DOFS {
+            anyhow::bail!(
+                "{}: a uniform {size_mm} mm mesh of this part ({v:.3e} mm³, {:.1} mm between the \
+                 pins) would have about {dofs:.1e} DOFs, beyond the {UNIFORM_MESH_MAX_DOFS:.0e} a \
+                 direct solve holds in memory: give a larger size, or check the units (sidecar \
+                 `units`, now {})",
+                self.context,
+                self.surface.centre_distance_mm,
+                design.settings.units.symbol()
+            );
+        }
+        Ok(())
+    }
+}
+
 /// A refinement study of a loaded design (`rodstudy fem --refine`): one uniform gmsh mesh per size
 /// in `sizes_mm` (each in `work_dir/<size>mm`), both cases at `force_n`, the band around the fixed
 /// bore from the configuration ([`crate::fem::refinement`]).
@@ -769,6 +876,9 @@ pub fn fem_refinement(
 ) -> Result<RefinementStudy> {
     // meshed in the rod frame, mm, as stage 3 meshes (any units and pose)
     let setup = Setup::new(design, config, true, false)?;
+    for &size in sizes_mm {
+        setup.check_uniform_size(design, size)?;
+    }
     let mesher = setup.mesher(work_dir)?;
     Ok(refinement_study(
         sizes_mm,
@@ -780,9 +890,11 @@ pub fn fem_refinement(
         &setup.material,
         &setup.bores,
         force_n,
+        // stage 3's options: "away" is the stress stage 3 judges (the bands around the fixed
+        // bore and the sharp re-entrant edges left out)
         &RodOptions {
-            fixed_band_m: Some(config.fem.fixed_band_mm * 1e-3),
-            ..RodOptions::default()
+            keep_system: false,
+            ..setup.rod.clone()
         },
     )?)
 }

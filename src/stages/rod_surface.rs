@@ -38,6 +38,18 @@ pub struct RodFrameSurface {
 pub const SIMPLIFY_TOLERANCE_MM: f64 = 0.005;
 
 impl RodFrameSurface {
+    /// The volume the surface encloses, mm³ (divergence theorem over its triangles).
+    pub fn volume_mm3(&self) -> f64 {
+        self.triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| nalgebra::Vector3::from(self.vertices[i as usize]));
+                a.dot(&b.cross(&c)) / 6.0
+            })
+            .sum::<f64>()
+            .abs()
+    }
+
     /// The pin axes in the rod frame: A at the origin, B at (l, 0, 0), along z.
     pub fn bores(&self) -> BoreSpec {
         BoreSpec::from_mm(

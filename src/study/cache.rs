@@ -3,7 +3,8 @@
 //! the designs concerned.
 //!
 //! The key is the SHA-256 of the program version, the configuration (as JSON), the bytes of its
-//! pressure trace if it has one, the STL bytes and the sidecar bytes. Entries live in `OUT/.cache/<id>.json`, written atomically.
+//! pressure trace if it has one, the STL bytes and the sidecar bytes. Entries live in `OUT/.cache/<id>.json` (a study without stage 3:
+//! `OUT/.cache/without-fem/<id>.json`), written atomically.
 
 use crate::config::StudyConfig;
 use crate::report::atomic_write::write_atomic;
@@ -45,8 +46,13 @@ pub struct Cache {
 
 impl Cache {
     pub fn new(out: &Path) -> Self {
+        Self::in_folder(&out.join(".cache"))
+    }
+
+    /// A cache in `folder` (e.g. `OUT/.cache/without-fem`, a study's without stage 3).
+    pub fn in_folder(folder: &Path) -> Self {
         Cache {
-            folder: out.join(".cache"),
+            folder: folder.to_path_buf(),
         }
     }
 

@@ -69,11 +69,23 @@ pub struct FailedDesign {
 
 /// One line that says what failed, from a message that carries a subprocess's log (a failed
 /// gmsh run: "… exited with …" and its standard error): the first line (which names the file and
-/// the stage) and the log's last error line, and what to try for a mesher failure; `None` for
-/// any other message (kept whole).
+/// the stage) and the log's last error line, and what to try for a mesher failure; from any
+/// other message of several lines (a TOML error's excerpt of the file) its first and last lines;
+/// `None` for a message of one line (kept whole).
 pub fn one_line(message: &str, log_name: &str) -> Option<String> {
     if !message.contains(" exited with ") {
-        return None;
+        let lines: Vec<&str> = message
+            .lines()
+            .map(str::trim)
+            .filter(|l| !l.is_empty())
+            .collect();
+        return match lines.as_slice() {
+            [] | [_] => None,
+            [first, .., last] => Some(format!(
+                "{}: {last} (full message: {log_name})",
+                first.trim_end_matches(':')
+            )),
+        };
     }
     let mut lines = message.lines().filter(|l| !l.trim().is_empty());
     let first = lines.next()?.trim_end_matches(':').to_string();
@@ -116,6 +128,18 @@ impl FailedDesign {
 #[cfg(test)]
 mod tests {
     use super::one_line;
+
+    #[test]
+    fn a_message_of_several_lines_becomes_its_first_and_last() {
+        let msg = "designs/x.stl: designs/x.toml: TOML parse error at line 3, column 1\n  |\n3 | densty = 7850\n  | ^^^^^^\nunknown field `densty`, expected one of `units`, `density`\n";
+        let line = one_line(msg, "x/failure.log").unwrap();
+        assert_eq!(
+            line,
+            "designs/x.stl: designs/x.toml: TOML parse error at line 3, column 1: unknown field \
+             `densty`, expected one of `units`, `density` (full message: x/failure.log)"
+        );
+        assert_eq!(one_line("designs/x.stl: one line", "x/failure.log"), None);
+    }
 
     #[test]
     fn a_mesher_log_becomes_one_line_that_names_the_cause_and_the_log() {

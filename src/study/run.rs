@@ -58,10 +58,29 @@ pub fn run_study(
     on_done: &(dyn Fn(Progress) + Sync),
 ) -> Result<StudyResults> {
     let designs = options.designs;
+    if designs.is_file() {
+        bail!(
+            "{}: --designs takes a folder of designs, not a file (`rodstudy fem`, `mass` and \
+             `dynamics driven` take single files)",
+            designs.display()
+        );
+    }
     if !designs.is_dir() {
         bail!("{}: the designs folder does not exist", designs.display());
     }
+    // the reports' folder must take files before any design is computed
+    std::fs::create_dir_all(options.out)
+        .and_then(|()| tempfile::NamedTempFile::new_in(options.out).map(drop))
+        .with_context(|| {
+            format!(
+                "{}: cannot write the reports there (--out)",
+                options.out.display()
+            )
+        })?;
     let all_files = find_stl_files(&[designs.to_path_buf()])?;
+    // designs whose reports would share a folder (the same file stem, or stems that differ only
+    // in case or in characters a file name cannot keep) are refused, all of them, by name
+    let clashes = clashing_ids(&all_files);
     let (files, shard_record) = match options.shard {
         None => (all_files, None),
         Some(sh) => {
@@ -78,7 +97,14 @@ pub fn run_study(
             (mine, Some(record))
         }
     };
-    let cache = Cache::new(options.out);
+    let (files, refused): (Vec<_>, Vec<_>) = files
+        .into_iter()
+        .partition(|f| !clashes.iter().any(|c| c.contains(f)));
+    let cache = if options.skip_fem {
+        Cache::in_folder(&options.out.join(".cache").join("without-fem"))
+    } else {
+        Cache::new(options.out)
+    };
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(options.jobs)
         .build()
@@ -125,7 +151,49 @@ pub fn run_study(
             Err(f) => results.failed.push(*f),
         }
     }
+    for f in refused {
+        let others: Vec<String> = clashes
+            .iter()
+            .find(|c| c.contains(&f))
+            .into_iter()
+            .flatten()
+            .filter(|o| **o != f)
+            .map(|o| o.display().to_string())
+            .collect();
+        let failed = FailedDesign {
+            file: f.display().to_string(),
+            error: format!(
+                "{}: its id `{}` names the same report folder as {} (ids are file stems, reports go \
+                 to OUT/<id>/): rename one of them",
+                f.display(),
+                shard::id_of(&f),
+                others.join(", ")
+            ),
+            stage: STAGES[0].into(),
+            ..FailedDesign::default()
+        };
+        on_done(Progress {
+            file: &f,
+            cached: false,
+            outcome: Err(failed.error.clone()),
+        });
+        results.failed.push(failed);
+    }
     Ok(results)
+}
+
+/// The groups of design files whose ids would share a report folder or cache entry: the same
+/// [`file_safe`] id up to case (a case-insensitive file system keeps one of them).
+fn clashing_ids(files: &[std::path::PathBuf]) -> Vec<Vec<std::path::PathBuf>> {
+    let mut by_key: std::collections::BTreeMap<String, Vec<std::path::PathBuf>> =
+        std::collections::BTreeMap::new();
+    for f in files {
+        by_key
+            .entry(file_safe(&shard::id_of(f)).to_lowercase())
+            .or_default()
+            .push(f.clone());
+    }
+    by_key.into_values().filter(|g| g.len() > 1).collect()
 }
 
 /// The stages for one design, from the cache when its content hash matches; the flag says
@@ -140,13 +208,9 @@ fn study_one(
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let key = cache.and_then(|_| design_key(stl, config).ok()).map(|k| {
-        if options.skip_fem {
-            format!("{k}-without-fem")
-        } else {
-            k
-        }
-    });
+    // a study without stage 3 keeps its entries in a folder of their own (run_study), so that
+    // it does not replace a whole study's
+    let key = cache.and_then(|_| design_key(stl, config).ok());
     let scene = config.driven_scene();
     // the per-design files stage 3 writes beside its figures: a cached entry without them is
     // recomputed
@@ -176,8 +240,11 @@ fn study_one(
             Method::ClosedForm,
         )
     {
+        // the same content may have moved: the record names the file studied now
+        let mut mass = hit.mass;
+        mass.file = stl.display().to_string();
         let result = DesignResult {
-            mass: hit.mass,
+            mass,
             dynamics: hit.dynamics,
             fem: hit.fem,
             cycle: hit.cycle,

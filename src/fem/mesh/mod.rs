@@ -3,6 +3,7 @@
 //!
 //! Element node order: VTK's tetra10 (see [`crate::fem::shape`]).
 
+pub mod pieces;
 pub mod structured;
 
 use super::element::{ElementCoords, QuadratureChoice, check_jacobian, is_straight};
