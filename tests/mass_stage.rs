@@ -221,6 +221,22 @@ fn units_and_pin_mistakes_are_explained() {
         e.contains("crank pin (A)") && e.contains("not inside a bore"),
         "{e}"
     );
+    // A crank pin 5 mm off the centre of design 1's Ø50 big-end bore: a wall all round it, so
+    // only the bore's own axis shows the mistake.
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let off = d.join("off.stl");
+    std::fs::copy(root.join("designs/design1.stl"), &off).unwrap();
+    write(
+        d,
+        "off.toml",
+        b"crank_pin = [5.0, 0.0, 0.0]\npiston_pin = [180.0, 0.0, 0.0]\n",
+    );
+    let e = error_of(&off);
+    assert!(
+        e.contains("crank pin (A) is 5.000 mm off the axis of the bore around it")
+            && e.contains("radius 25.000 mm"),
+        "{e}"
+    );
     // A sidecar with a typo.
     write(d, "pins.toml", b"densty = 7000.0\n");
     let e = error_of(&rod);

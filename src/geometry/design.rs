@@ -355,7 +355,9 @@ fn rod_record(d: &LoadedDesign, stl: &Path) -> Result<DesignMass> {
     }
     let surface = RodSurface::new(&d.mesh).with_context(file)?;
     let mut warnings = Vec::new();
-    let crank = pin_bore(d, &surface, Pin::Crank, &mut warnings).with_context(file);
+    // the bores the geometry shows, once, for sidecar pins to be checked against
+    let bores = std::cell::OnceCell::new();
+    let crank = pin_bore(d, &surface, Pin::Crank, &bores, &mut warnings).with_context(file);
     let crank = match (crank, &d.pins.search_error) {
         (Err(e), Some(why)) => {
             return Err(e.context(format!(
@@ -366,7 +368,8 @@ fn rod_record(d: &LoadedDesign, stl: &Path) -> Result<DesignMass> {
         }
         (r, _) => r?,
     };
-    let piston = pin_bore(d, &surface, Pin::Piston, &mut warnings).with_context(file)?;
+    let piston =
+        pin_bore(d, &surface, Pin::Piston, &bores, &mut warnings).with_context(file)?;
     let rod = RodInFrame::new(&d.frame, &d.mass);
     if !(rod.l1_m > 0.0 && rod.l1_m < rod.centre_distance_m) {
         bail!(
@@ -404,8 +407,10 @@ fn pin_bore(
     d: &LoadedDesign,
     surface: &RodSurface,
     pin: Pin,
+    bores: &std::cell::OnceCell<Vec<Bore>>,
     warnings: &mut Vec<String>,
 ) -> Result<PinBore> {
+    let bores = || bores.get_or_init(|| find_bores(&d.mesh));
     let scale = d.settings.units.to_metres();
     let units = d.settings.units.symbol();
     let axis = d.frame.z;
@@ -434,17 +439,22 @@ fn pin_bore(
         return partial(bore, warnings);
     }
     match surface.bore_radius(name, centre, axis, scale, units) {
-        Ok(radius) => Ok(PinBore {
-            radius,
-            arc_deg: 360.0,
-        }),
+        Ok(radius) => {
+            if d.pins.source == PinsSource::Sidecar {
+                pin_on_the_bores_axis(d, bores(), name, centre, axis)?;
+            }
+            Ok(PinBore {
+                radius,
+                arc_deg: 360.0,
+            })
+        }
         Err(e)
             if d.pins.source == PinsSource::Sidecar
                 && surface.probe(centre, axis).open_share() > 0.0 =>
         {
             // sidecar pins in an open arc? measure the partial bores
-            let near = find_bores(&d.mesh)
-                .into_iter()
+            let near = bores()
+                .iter()
                 .filter(|b| !b.full && b.axis_v().dot(&axis).abs() > 1f64.to_radians().cos())
                 .min_by(|a, b| {
                     a.distance_from_axis(centre)
@@ -472,6 +482,46 @@ fn pin_bore(
         }
         Err(e) => Err(e),
     }
+}
+
+/// A sidecar's pin must sit on the axis of the bore around it: the bore the geometry shows
+/// there (found as the pin search finds bores; within the bore's radius of the pin, its axis
+/// parallel) may lie at most 1 % of its radius from the pin, as for a partial bore. A pin off
+/// the centre still sees a wall all round, so the bore check alone would pass it and measure
+/// the wrong radius and centre distance.
+fn pin_on_the_bores_axis(
+    d: &LoadedDesign,
+    bores: &[Bore],
+    name: &str,
+    centre: Vector3<f64>,
+    axis: Vector3<f64>,
+) -> Result<()> {
+    let scale = d.settings.units.to_metres();
+    let units = d.settings.units.symbol();
+    let near = bores
+        .iter()
+        .filter(|b| b.full && b.axis_v().dot(&axis).abs() > 1f64.to_radians().cos())
+        .filter(|b| b.distance_from_axis(centre) < b.radius)
+        .min_by(|a, b| {
+            a.distance_from_axis(centre)
+                .total_cmp(&b.distance_from_axis(centre))
+        });
+    let Some(bore) = near else { return Ok(()) };
+    let off = bore.distance_from_axis(centre);
+    if off <= 0.01 * bore.radius {
+        return Ok(());
+    }
+    let c = bore.centre_v() / scale;
+    bail!(
+        "the sidecar's {name} is {:.3} {units} off the axis of the bore around it (radius {:.3} \
+         {units}, axis through ({:.3}, {:.3}, {:.3}) {units}): correct the pin centre in the \
+         sidecar, or leave the pins out to have them found from the geometry",
+        off / scale,
+        bore.radius / scale,
+        c.x,
+        c.y,
+        c.z
+    )
 }
 
 /// The record; the mechanism-frame fields NaN when `rod` is `None`.
