@@ -404,3 +404,42 @@ fn a_later_stage_failure_keeps_the_earlier_figures() {
         String::from_utf8_lossy(&c.stdout)
     );
 }
+
+/// A study whose reports cannot all be written (a plain file where a design's folder goes)
+/// fails without replacing any report: the last complete set stays.
+#[test]
+fn reports_are_replaced_as_a_set_or_not_at_all() {
+    let designs = tempfile::tempdir().unwrap();
+    let out = tempfile::tempdir().unwrap();
+    rod_file(designs.path(), "a.stl");
+    rod_file(designs.path(), "b.stl");
+    let (d, o) = (
+        designs.path().to_str().unwrap(),
+        out.path().to_str().unwrap(),
+    );
+    let first = rodstudy(&["study", "--skip-fem", "--designs", d, "--out", o]);
+    assert_eq!(first.status.code(), Some(0));
+    let read = |f: &str| std::fs::read(out.path().join(f)).unwrap();
+    let before: Vec<Vec<u8>> = ["results.json", "index.html", "ranking.md"]
+        .iter()
+        .map(|f| read(f))
+        .collect();
+    std::fs::write(designs.path().join("b.toml"), "name = \"B renamed\"\n").unwrap();
+    std::fs::remove_dir_all(out.path().join("a")).unwrap();
+    std::fs::write(out.path().join("a"), "in the way").unwrap();
+    let second = rodstudy(&["study", "--skip-fem", "--designs", d, "--out", o]);
+    let e = String::from_utf8_lossy(&second.stderr);
+    assert_eq!(second.status.code(), Some(2), "{e}");
+    let after: Vec<Vec<u8>> = ["results.json", "index.html", "ranking.md"]
+        .iter()
+        .map(|f| read(f))
+        .collect();
+    assert!(before == after, "a report was replaced: {e}");
+    let leftovers: Vec<String> = std::fs::read_dir(out.path())
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with(".reports-") || n.starts_with(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}

@@ -368,8 +368,7 @@ fn rod_record(d: &LoadedDesign, stl: &Path) -> Result<DesignMass> {
         }
         (r, _) => r?,
     };
-    let piston =
-        pin_bore(d, &surface, Pin::Piston, &bores, &mut warnings).with_context(file)?;
+    let piston = pin_bore(d, &surface, Pin::Piston, &bores, &mut warnings).with_context(file)?;
     let rod = RodInFrame::new(&d.frame, &d.mass);
     if !(rod.l1_m > 0.0 && rod.l1_m < rod.centre_distance_m) {
         bail!(

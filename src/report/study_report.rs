@@ -5,7 +5,7 @@
 use super::atomic_write::write_atomic;
 use super::{design_files, file_safe, index_page, mass_properties, pareto, plots, ranking};
 use crate::study::results::StudyResults;
-use anyhow::Result;
+use anyhow::{Context, Result};
 use std::path::{Path, PathBuf};
 
 /// The keys of the stage-3 record that hold wall times or memory: they vary from run to run.
@@ -33,14 +33,51 @@ fn strip_wall_times(v: &mut serde_json::Value) {
     }
 }
 
-/// Writes `results.json`, `mass_properties.md` and `mass_properties.csv` into `out`
-/// (each atomically) and returns their paths.
+/// Writes the study's reports into `out` (see the module documentation) and returns their
+/// paths; removes the stage files a design's folder keeps from an earlier study.
 pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>> {
+    // every file is made in a staging folder first and moved into place only when all of them
+    // are made, so that a failure part-way (a folder in the way, a full disk) leaves the last
+    // complete set of reports, not a mix of two
+    std::fs::create_dir_all(out).with_context(|| format!("{}: cannot create", out.display()))?;
+    // a staging folder an interrupted run left behind
+    for entry in std::fs::read_dir(out)?.flatten() {
+        if entry.file_name().to_string_lossy().starts_with(".reports-") {
+            let _ = std::fs::remove_dir_all(entry.path());
+        }
+    }
+    let staging = tempfile::Builder::new()
+        .prefix(".reports-")
+        .tempdir_in(out)
+        .with_context(|| format!("{}: cannot write the reports there", out.display()))?;
+    let made = write_report_files(results, staging.path())?;
+    remove_stale_stage_files(results, out)?;
+    let mut written = Vec::with_capacity(made.len() + 1);
+    for file in made {
+        let relative = file.strip_prefix(staging.path())?;
+        let target = out.join(relative);
+        if let Some(folder) = target.parent() {
+            std::fs::create_dir_all(folder)
+                .with_context(|| format!("{}: cannot create", folder.display()))?;
+        }
+        std::fs::rename(&file, &target)
+            .with_context(|| format!("{}: cannot write", target.display()))?;
+        written.push(target);
+    }
+    // last, on the files in place: the page links what exists
+    let index = out.join("index.html");
+    write_atomic(&index, index_page::index_html(results, out).as_bytes())?;
+    written.push(index);
+    Ok(written)
+}
+
+/// The report files of [`write_reports`] but the index page, written under `dest`.
+fn write_report_files(results: &StudyResults, dest: &Path) -> Result<Vec<PathBuf>> {
     // results.json holds only what the computation decides (it is committed and must not change
     // from run to run); the same record with the wall times goes to timings.json (not committed)
     let full = serde_json::to_value(results)?;
     write_atomic(
-        &out.join("timings.json"),
+        &dest.join("timings.json"),
         serde_json::to_string_pretty(&full)?.as_bytes(),
     )?;
     let mut stable = full;
@@ -53,21 +90,21 @@ pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>>
             }
         }
     }
-    let json = out.join("results.json");
+    let json = dest.join("results.json");
     write_atomic(&json, serde_json::to_string_pretty(&stable)?.as_bytes())?;
-    let md = out.join("mass_properties.md");
+    let md = dest.join("mass_properties.md");
     write_atomic(&md, mass_properties::markdown(results).as_bytes())?;
-    let csv_path = out.join("mass_properties.csv");
+    let csv_path = dest.join("mass_properties.csv");
     write_atomic(&csv_path, &mass_properties::csv_table(results)?)?;
-    let ranking = out.join("ranking.md");
+    let ranking = dest.join("ranking.md");
     write_atomic(&ranking, ranking::markdown(results).as_bytes())?;
-    let ranking_csv = out.join("ranking.csv");
+    let ranking_csv = dest.join("ranking.csv");
     write_atomic(&ranking_csv, &ranking::csv(results)?)?;
     let mut written = vec![json, md, csv_path, ranking, ranking_csv];
     // a failure whose message was cut to one line keeps its whole log beside the reports
     for f in &results.failed {
         if let Some(log) = &f.log {
-            let path = out.join(file_safe(&f.id())).join("failure.log");
+            let path = dest.join(file_safe(&f.id())).join("failure.log");
             write_atomic(&path, log.as_bytes())?;
             written.push(path);
         }
@@ -75,7 +112,7 @@ pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>>
     let histories = design_files::histories(results);
     let scene = design_files::scene_label(&results.config);
     for (id, design, h) in &histories {
-        let dir = out.join(file_safe(id));
+        let dir = dest.join(file_safe(id));
         let path = dir.join("pin_force.csv");
         write_atomic(&path, &design_files::pin_force_csv(design, h)?)?;
         let plot = dir.join("pin_force.svg");
@@ -87,7 +124,7 @@ pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>>
     }
     for d in &results.designs {
         if let Some(c) = &d.cycle {
-            let dir = out.join(file_safe(&d.mass.id));
+            let dir = dest.join(file_safe(&d.mass.id));
             let path = dir.join("cycle.csv");
             write_atomic(&path, &design_files::cycle_csv(c)?)?;
             let plot = dir.join("cycle.svg");
@@ -99,12 +136,12 @@ pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>>
         }
     }
     if !histories.is_empty() {
-        let pin = out.join("pin_force.svg");
+        let pin = dest.join("pin_force.svg");
         write_atomic(
             &pin,
             design_files::pin_force_plot(&histories, &scene)?.as_bytes(),
         )?;
-        let bars = out.join("peak_force.svg");
+        let bars = dest.join("peak_force.svg");
         let peaks: Vec<(String, f64)> = ranking::ranking(results)
             .iter()
             .filter_map(|r| Some((r.mass.id.clone(), r.peak_force_n()?)))
@@ -121,11 +158,11 @@ pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>>
         written.extend([pin, bars]);
     }
     if !results.designs.is_empty() {
-        let md = out.join("pareto.md");
+        let md = dest.join("pareto.md");
         write_atomic(&md, pareto::markdown(results).as_bytes())?;
-        let csv_path = out.join("pareto.csv");
+        let csv_path = dest.join("pareto.csv");
         write_atomic(&csv_path, &pareto::csv(results)?)?;
-        let svg = out.join("pareto.svg");
+        let svg = dest.join("pareto.svg");
         let points: Vec<plots::LabelledPoint> = pareto::pareto(results)
             .into_iter()
             .map(|r| plots::LabelledPoint {
@@ -153,10 +190,6 @@ pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>>
         )?;
         written.extend([md, csv_path, svg]);
     }
-    let index = out.join("index.html");
-    write_atomic(&index, index_page::index_html(results, out).as_bytes())?;
-    written.push(index);
-    remove_stale_stage_files(results, out)?;
     Ok(written)
 }
 
