@@ -471,7 +471,7 @@ fn pin_bore(
                 c.z
             );
             if off <= 0.01 * bore.radius {
-                partial(&bore, warnings)
+                partial(bore, warnings)
             } else {
                 bail!(
                     "{what}; the sidecar's {name} is {:.3} {units} away from that axis: correct the pin centre in the sidecar",
