@@ -175,6 +175,18 @@ gmsh.finalize()
             .unwrap()
     );
     assert!(e.contains("junk.step"), "{e}");
+    // an empty file and a file of another kind are named as such before OpenCASCADE reads them
+    for (name, text, says) in [
+        ("empty.stp", "", "empty file"),
+        ("drawing.step", "%PDF-1.7 a drawing", "not a STEP file"),
+    ] {
+        std::fs::write(dir.path().join(name), text).unwrap();
+        let e = format!(
+            "{:#}",
+            stages::mass::load(&dir.path().join(name)).err().unwrap()
+        );
+        assert!(e.contains(name) && e.contains(says), "{e}");
+    }
 }
 
 fn run_foreign_rods(out: &Path) -> serde_json::Value {

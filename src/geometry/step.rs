@@ -71,9 +71,33 @@ impl StepReport {
     }
 }
 
+/// An ISO 10303-21 file begins with `ISO-10303-21;` (after optional white space): an empty file
+/// or another kind of file is named as such before OpenCASCADE's bare "Could not read file".
+fn check_step_header(step: &Path) -> Result<()> {
+    use std::io::Read;
+    let mut head = Vec::with_capacity(64);
+    std::fs::File::open(step)
+        .and_then(|f| f.take(4096).read_to_end(&mut head))
+        .with_context(|| format!("{}: cannot read", step.display()))?;
+    let text = String::from_utf8_lossy(&head);
+    let text = text.trim_start_matches('\u{feff}').trim_start();
+    if text.is_empty() {
+        bail!("{}: empty file (a STEP export has content)", step.display());
+    }
+    if !text.starts_with("ISO-10303-21;") {
+        bail!(
+            "{}: not a STEP file (an ISO 10303-21 file begins with `ISO-10303-21;`): export the \
+             part again as STEP AP203/AP214/AP242",
+            step.display()
+        );
+    }
+    Ok(())
+}
+
 /// Reads `step` with `python` and the reader script, writing the surface triangulation to
 /// `stl_out`.
 pub fn read_step(python: &Path, script: &Path, step: &Path, stl_out: &Path) -> Result<StepReport> {
+    check_step_header(step)?;
     let out = Command::new(python)
         .arg(script)
         .arg("read")
