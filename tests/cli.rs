@@ -378,3 +378,27 @@ fn mass_of_a_plain_box_without_bores() {
     let msg = String::from_utf8_lossy(&study.stderr);
     assert!(msg.contains("lies inside material, not in a bore"), "{msg}");
 }
+
+/// `dynamics table-5-1 --json` says its scene in every row.
+#[test]
+fn table_5_1_json_rows_name_their_scene() {
+    for (args, gravity) in [
+        (&["dynamics", "table-5-1", "--json"][..], true),
+        (
+            &["dynamics", "table-5-1", "--json", "--no-gravity"][..],
+            false,
+        ),
+    ] {
+        let o = rodstudy(args, &[]);
+        assert!(o.status.success());
+        let rows: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        let rows = rows.as_array().unwrap();
+        assert_eq!(rows.len(), 5);
+        for r in rows {
+            assert_eq!(r["gravity"], gravity);
+            let w = r["omega_rad_s"].as_f64().unwrap();
+            assert!((w - 40.0 * std::f64::consts::PI).abs() < 1e-12);
+            assert!(r["computed_peak_n"].as_f64().unwrap() > 1000.0);
+        }
+    }
+}

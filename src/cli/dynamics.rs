@@ -398,7 +398,23 @@ fn table51(json: bool, gravity: bool) -> Result<i32> {
     // The thesis gives no pin-axis inertia; the peak at top dead centre does not depend on it.
     let rows = table_5_1_check(&params, 0.02)?;
     if json {
-        println!("{}", serde_json::to_string_pretty(&rows)?);
+        // each row says its scene (the table is at 40π rad/s; gravity as asked)
+        #[derive(serde::Serialize)]
+        struct Row<'a, T: serde::Serialize> {
+            #[serde(flatten)]
+            row: &'a T,
+            omega_rad_s: f64,
+            gravity: bool,
+        }
+        let v: Vec<_> = rows
+            .iter()
+            .map(|row| Row {
+                row,
+                omega_rad_s: crate::mechanism::table_5_1::THESIS_OMEGA_RAD_S,
+                gravity,
+            })
+            .collect();
+        println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(0);
     }
     println!(
