@@ -219,6 +219,17 @@ pub fn load_design(stl: &Path) -> Result<LoadedDesign> {
         if report.solids_in_file > 1 {
             notes.push(report.description());
         }
+        // a folder's NAME.stl beside NAME.step is not studied (find_stl_files): say so
+        for ext in ["stl", "STL", "Stl"] {
+            let beside = stl.with_extension(ext);
+            if beside.is_file() {
+                notes.push(format!(
+                    "{} beside it is not studied: the STEP's exact geometry is the design",
+                    beside.display()
+                ));
+                break;
+            }
+        }
         (soup, DesignFormat::Step(report), notes)
     } else {
         let (soup, format) = read_stl_file(stl).with_context(file)?;

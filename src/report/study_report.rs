@@ -52,23 +52,42 @@ pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>>
         .with_context(|| format!("{}: cannot write the reports there", out.display()))?;
     let made = write_report_files(results, staging.path())?;
     remove_stale_stage_files(results, out)?;
-    let mut written = Vec::with_capacity(made.len() + 1);
-    for file in made {
-        let relative = file.strip_prefix(staging.path())?;
-        let target = out.join(relative);
+    // every file made (timings.json too, which the list of reports leaves out) goes in
+    for file in files_under(staging.path())? {
+        let target = out.join(file.strip_prefix(staging.path())?);
         if let Some(folder) = target.parent() {
             std::fs::create_dir_all(folder)
                 .with_context(|| format!("{}: cannot create", folder.display()))?;
         }
         std::fs::rename(&file, &target)
             .with_context(|| format!("{}: cannot write", target.display()))?;
-        written.push(target);
     }
+    let mut written: Vec<PathBuf> = made
+        .iter()
+        .map(|f| f.strip_prefix(staging.path()).map(|r| out.join(r)))
+        .collect::<std::result::Result<_, _>>()?;
     // last, on the files in place: the page links what exists
     let index = out.join("index.html");
     write_atomic(&index, index_page::index_html(results, out).as_bytes())?;
     written.push(index);
     Ok(written)
+}
+
+/// The files under `folder`, at any depth.
+fn files_under(folder: &Path) -> Result<Vec<PathBuf>> {
+    let mut files = Vec::new();
+    let mut todo = vec![folder.to_path_buf()];
+    while let Some(dir) = todo.pop() {
+        for entry in std::fs::read_dir(&dir)? {
+            let path = entry?.path();
+            if path.is_dir() {
+                todo.push(path);
+            } else {
+                files.push(path);
+            }
+        }
+    }
+    Ok(files)
 }
 
 /// The report files of [`write_reports`] but the index page, written under `dest`.
