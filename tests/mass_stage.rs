@@ -237,6 +237,20 @@ fn units_and_pin_mistakes_are_explained() {
             && e.contains("radius 25.000 mm"),
         "{e}"
     );
+    // 0.3 mm off (1.2 % of the radius, a rounded coordinate): studied, with a warning
+    write(
+        d,
+        "off.toml",
+        b"crank_pin = [0.3, 0.0, 0.0]\npiston_pin = [180.0, 0.0, 0.0]\n",
+    );
+    let near = mass_of_design(&off).unwrap();
+    assert!(
+        near.warnings
+            .iter()
+            .any(|w| w.contains("crank pin (A) is 0.300 mm off the axis")),
+        "{:?}",
+        near.warnings
+    );
     // A sidecar with a typo.
     write(d, "pins.toml", b"densty = 7000.0\n");
     let e = error_of(&rod);
@@ -275,7 +289,9 @@ fn implausible_mass_is_warned_about() {
     );
     let e = format!("{:#}", mass_of_design(&path).unwrap_err());
     assert!(
-        e.contains("metres.stl") && e.contains("cannot be a connecting rod's"),
+        e.contains("metres.stl")
+            && e.contains("cannot be a connecting rod's")
+            && e.contains("`density`"),
         "{e}"
     );
 }

@@ -134,6 +134,28 @@ fn three_shards_merge_into_the_one_machine_reports() {
     ]);
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(e.contains("not a shard"), "{e}");
+    // a shard of the same ids in another designs folder (sweeps name their rods alike)
+    let copy = t.join("designs-copy");
+    std::fs::create_dir_all(&copy).unwrap();
+    for e in std::fs::read_dir(&designs).unwrap().flatten() {
+        std::fs::copy(e.path(), copy.join(e.file_name())).unwrap();
+    }
+    let elsewhere = t.join("s2-elsewhere");
+    study(&copy, &elsewhere, &["--shard", "2/3"]);
+    let o = rodstudy(&[
+        "merge",
+        &dirs[0],
+        elsewhere.to_str().unwrap(),
+        &dirs[2],
+        "--out",
+        t.join("m6").to_str().unwrap(),
+    ]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("read one designs folder"), "{e}");
+    // the merged reports into one of the shards' folders
+    let o = rodstudy(&["merge", &dirs[0], &dirs[1], &dirs[2], "--out", &dirs[1]]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("--out is one of the shards"), "{e}");
 }
 
 /// With an engine (the example pressure trace over 720°), the merge recomputes each design's

@@ -164,16 +164,20 @@ fn second_run_uses_the_cache_and_a_changed_design_reruns_alone() {
     // files of stage 3 and the cycle that an earlier study left in a design's folder
     let stale = out.path().join("a");
     std::fs::create_dir_all(&stale).unwrap();
-    for f in ["fem_fx.vtu", "von_mises_fy.svg", "cycle.csv"] {
+    for f in ["fem_fx.vtu", "von_mises_fy.svg", "cycle.csv", "failure.log"] {
         std::fs::write(stale.join(f), "from an earlier study").unwrap();
     }
     let first = rodstudy(&["study", "--skip-fem", "--designs", d, "--out", o]);
     assert!(String::from_utf8_lossy(&first.stderr).contains("(0 from the cache)"));
-    // a study without stage 3 removes them: nothing in a design's folder disagrees with it
+    // a study without stage 3 keeps them (a whole study's cache needs them) but does not link
+    // them; an old failure.log of a design now studied goes
     for f in ["fem_fx.vtu", "von_mises_fy.svg", "cycle.csv"] {
-        assert!(!stale.join(f).exists(), "{f} left behind");
+        assert!(stale.join(f).exists(), "{f} removed");
     }
-    assert!(stale.join("pin_force.csv").is_file());
+    let index = std::fs::read_to_string(out.path().join("index.html")).unwrap();
+    assert!(index.contains("a/pin_force.csv") && !index.contains("a/fem_fx.vtu"));
+    assert!(!index.contains("a/cycle.csv") && !index.contains("a/von_mises_fy.svg"));
+    assert!(!stale.join("failure.log").exists());
     let second = rodstudy(&["study", "--skip-fem", "--designs", d, "--out", o]);
     assert!(String::from_utf8_lossy(&second.stderr).contains("(2 from the cache)"));
     std::fs::write(designs.path().join("b.toml"), "name = \"B renamed\"\n").unwrap();
@@ -416,6 +420,22 @@ fn reports_are_replaced_as_a_set_or_not_at_all() {
     let second = rodstudy(&["study", "--skip-fem", "--designs", d, "--out", o]);
     let e = String::from_utf8_lossy(&second.stderr);
     assert_eq!(second.status.code(), Some(2), "{e}");
+    let after: Vec<Vec<u8>> = ["results.json", "index.html", "ranking.md"]
+        .iter()
+        .map(|f| read(f))
+        .collect();
+    assert!(before == after, "a report was replaced: {e}");
+    // a folder where a design's plot goes: refused before any report moves
+    std::fs::remove_file(out.path().join("a")).unwrap();
+    let plot = out.path().join("b").join("pin_force.svg");
+    std::fs::remove_file(&plot).unwrap();
+    std::fs::create_dir_all(&plot).unwrap();
+    let third = rodstudy(&["study", "--skip-fem", "--designs", d, "--out", o]);
+    let e = String::from_utf8_lossy(&third.stderr);
+    assert!(
+        third.status.code() == Some(2) && e.contains("a folder is in the way"),
+        "{e}"
+    );
     let after: Vec<Vec<u8>> = ["results.json", "index.html", "ranking.md"]
         .iter()
         .map(|f| read(f))

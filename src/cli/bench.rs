@@ -14,11 +14,11 @@ use std::path::PathBuf;
 pub enum BenchCommand {
     /// Stage 1 on a generated torus mesh: read, weld, validate, integrate vs reading the bytes.
     Mass {
-        /// Approximate number of triangles of the generated mesh.
-        #[arg(long, default_value_t = 1_000_000)]
+        /// Approximate number of triangles of the generated mesh (at least 1000).
+        #[arg(long, default_value_t = 1_000_000, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1000..))]
         triangles: usize,
-        /// Repeats per step; the median is reported.
-        #[arg(long, default_value_t = 5)]
+        /// Repeats per step (at least 1); the median is reported.
+        #[arg(long, default_value_t = 5, value_parser = at_least_one)]
         repeats: usize,
         #[arg(long)]
         json: bool,
@@ -34,8 +34,8 @@ pub enum BenchCommand {
         /// A volume mesh of the design (in its units and pose): time the fixed-mesh path.
         #[arg(long)]
         mesh: Option<PathBuf>,
-        /// With `--mesh`: repeats per phase; the median is reported.
-        #[arg(long, default_value_t = 3, requires = "mesh")]
+        /// With `--mesh`: repeats per phase (at least 1); the median is reported.
+        #[arg(long, default_value_t = 3, requires = "mesh", value_parser = at_least_one)]
         repeats: usize,
         /// With `--mesh`: also run CalculiX on the same mesh (pipeline/ccx_peer.py).
         #[arg(long, requires = "mesh")]
@@ -44,11 +44,13 @@ pub enum BenchCommand {
         /// assembly, symbolic analysis, factorisation, solves, stresses with the estimate.
         #[arg(long, conflicts_with = "mesh")]
         adaptive: bool,
-        /// Element size [mm].
-        #[arg(long, default_value_t = 5.0)]
-        size: f64,
-        /// Load of both cases [N] (default: each design's peak pin force).
-        #[arg(long)]
+        /// Element size [mm] (default 5; not with `--mesh`, which is the mesh, nor `--adaptive`,
+        /// which sizes its own meshes).
+        #[arg(long, conflicts_with_all = ["mesh", "adaptive"])]
+        size: Option<f64>,
+        /// Load of both cases [N] (default: each design's peak pin force; not with `--adaptive`,
+        /// which loads each design with its own).
+        #[arg(long, conflicts_with = "adaptive")]
         force: Option<f64>,
         #[arg(long)]
         json: bool,
@@ -58,8 +60,8 @@ pub enum BenchCommand {
     Dynamics {
         /// An STL design whose rod is used instead of the thesis' original rod.
         design: Option<PathBuf>,
-        /// Repeats per method; the median is reported.
-        #[arg(long, default_value_t = 11)]
+        /// Repeats per method (at least 1); the median is reported.
+        #[arg(long, default_value_t = 11, value_parser = at_least_one)]
         repeats: usize,
         #[arg(long)]
         json: bool,
@@ -121,7 +123,7 @@ pub fn run(command: BenchCommand) -> Result<i32> {
             force,
             json,
             ..
-        } => bench_fem(designs, size, force, json),
+        } => bench_fem(designs, size.unwrap_or(5.0), force, json),
         BenchCommand::Dynamics {
             design,
             repeats,
@@ -285,4 +287,14 @@ fn bench_fem(designs: Vec<PathBuf>, size: f64, force: Option<f64>, json: bool) -
         );
     }
     Ok(0)
+}
+
+/// `--repeats`: a whole number ≥ 1.
+fn at_least_one(v: &str) -> std::result::Result<usize, String> {
+    match v.parse::<usize>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err(format!(
+            "'{v}' is not a number of repeats (a whole number ≥ 1)"
+        )),
+    }
 }

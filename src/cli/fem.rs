@@ -333,9 +333,15 @@ fn refine(
         return Ok(0);
     }
     println!(
-        "refinement study of {} at {:.1} N\n",
+        "refinement study of {} at {:.1} N{}; \"away\": the judged stress (bands at the fixed \
+         bore and the sharp edges left out)\n",
         args.design.display(),
-        force
+        force,
+        if config.engine.pressure_trace.is_some() {
+            " (F_x; F_y carries the engine's largest pin force across the rod)"
+        } else {
+            " (both cases)"
+        }
     );
     println!(
         "| size [mm] | elements | DOFs | F_x unaveraged / averaged / away [MPa] | F_y unaveraged / averaged / away [MPa] | F_y max displ. [mm] | F_x / F_y recovered peak [MPa] | F_x / F_y est. error | F_x / F_y bound at peak | F_x / F_y energy error | mesh [s] | solve [s] |\n|---|---|---|---|---|---|---|---|---|---|---|---|"

@@ -38,8 +38,9 @@ pub struct StudyArgs {
     /// Recompute every design even when its cached results are current.
     #[arg(long)]
     no_cache: bool,
-    /// Also write OUT/baseline.json from these results (on purpose: it is what CI checks against).
-    #[arg(long)]
+    /// Also write OUT/baseline.json from these results (on purpose: it is what CI checks against;
+    /// a whole study's, so not with `--shard`).
+    #[arg(long, conflicts_with = "shard")]
     update_baseline: bool,
 }
 

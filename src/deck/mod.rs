@@ -33,7 +33,7 @@ pub use solve::{DeckSolution, SolveOptions, solve_model};
 pub fn read_deck(path: &Path) -> Result<Model> {
     let text = std::fs::read_to_string(path).map_err(|e| FemError::Io {
         path: path.to_path_buf(),
-        source: e,
+        error: e,
     })?;
     read_deck_text(path, &text)
 }

@@ -157,6 +157,6 @@ pub fn write_step_vtu(path: &Path, sol: &DeckSolution, k: usize) -> Result<()> {
     out.push_str("</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
     std::fs::write(path, out).map_err(|e| FemError::Io {
         path: path.to_path_buf(),
-        source: e,
+        error: e,
     })
 }

@@ -81,12 +81,12 @@ pub enum FemError {
     #[error("invalid input: {0}")]
     InvalidInput(String),
     /// File system errors, with the file.
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {error}", path.display())]
     Io {
         /// The file or folder.
         path: PathBuf,
-        /// The error.
-        source: std::io::Error,
+        /// The error (in the message, not a separate cause: a chain would print it twice).
+        error: std::io::Error,
     },
     /// A mesh file that cannot be parsed.
     #[error("{}{}: {message}", path.display(), line_part(*line))]
@@ -114,7 +114,7 @@ impl FemError {
     pub(crate) fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
         FemError::Io {
             path: path.into(),
-            source,
+            error: source,
         }
     }
 }

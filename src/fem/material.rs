@@ -35,7 +35,7 @@ impl Material {
         let (e, nu) = (self.youngs_modulus_pa, self.poisson_ratio);
         if !(e.is_finite() && e > 0.0) {
             return Err(FemError::InvalidInput(format!(
-                "Young's modulus must be > 0 Pa, got {e}"
+                "Young's modulus must be > 0, got {e}"
             )));
         }
         if !(nu.is_finite() && nu > -1.0 && nu < 0.5) {

@@ -20,7 +20,8 @@ pub struct CaseMeasures {
     pub max_unaveraged_mpa: f64,
     /// Max nodally averaged von Mises, MPa.
     pub max_averaged_mpa: f64,
-    /// Max nodally averaged von Mises outside the band around the fixed bore, MPa.
+    /// Max nodally averaged von Mises outside the band around the fixed bore (and, with the
+    /// options stage 3 passes, the bands along the sharp re-entrant edges): the judged stress, MPa.
     pub max_away_from_fixed_mpa: f64,
     /// Max displacement, mm.
     pub max_displacement_mm: f64,

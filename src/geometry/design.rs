@@ -224,7 +224,8 @@ pub fn load_design(stl: &Path) -> Result<LoadedDesign> {
             let beside = stl.with_extension(ext);
             if beside.is_file() {
                 notes.push(format!(
-                    "{} beside it is not studied: the STEP's exact geometry is the design",
+                    "{} beside it: a study of the folder takes the STEP's exact geometry as the \
+                     design and leaves the STL out",
                     beside.display()
                 ));
                 break;
@@ -348,12 +349,13 @@ fn rod_record(d: &LoadedDesign, stl: &Path) -> Result<DesignMass> {
     let (lo, hi) = REFUSED_MASS_KG;
     if !(lo..=hi).contains(&d.mass.mass) {
         bail!(
-            "{}: mass {:.4e} kg cannot be a connecting rod's ({lo:e}–{hi:e} kg): the units are \
-             wrong (sidecar `units`, now {}; a millimetre file read as metres weighs 1e9 times \
-             as much)",
+            "{}: mass {:.4e} kg cannot be a connecting rod's ({lo:e}–{hi:e} kg): the units or \
+             the density are wrong (sidecar `units`, now {}: a millimetre file read as metres \
+             weighs 1e9 times as much; `density`, now {} kg/m³: steel is 7850)",
             stl.display(),
             d.mass.mass,
-            d.settings.units.symbol()
+            d.settings.units.symbol(),
+            d.settings.density
         );
     }
     if let Some(e) = &d.pins.search_error
@@ -451,7 +453,7 @@ fn pin_bore(
     match surface.bore_radius(name, centre, axis, scale, units) {
         Ok(radius) => {
             if d.pins.source == PinsSource::Sidecar {
-                pin_on_the_bores_axis(d, bores(), name, centre, axis)?;
+                pin_on_the_bores_axis(d, bores(), name, centre, axis, warnings)?;
             }
             Ok(PinBore {
                 radius,
@@ -496,15 +498,17 @@ fn pin_bore(
 
 /// A sidecar's pin must sit on the axis of the bore around it: the bore the geometry shows
 /// there (found as the pin search finds bores; within the bore's radius of the pin, its axis
-/// parallel) may lie at most 1 % of its radius from the pin, as for a partial bore. A pin off
-/// the centre still sees a wall all round, so the bore check alone would pass it and measure
-/// the wrong radius and centre distance.
+/// parallel) may lie 1 % of its radius from the pin unremarked, up to 5 % with a warning (a pin
+/// rounded to 0.1 mm in a small bore), beyond that the design is refused. A pin off the centre
+/// still sees a wall all round, so the bore check alone would pass it and measure the wrong
+/// radius and centre distance.
 fn pin_on_the_bores_axis(
     d: &LoadedDesign,
     bores: &[Bore],
     name: &str,
     centre: Vector3<f64>,
     axis: Vector3<f64>,
+    warnings: &mut Vec<String>,
 ) -> Result<()> {
     let scale = d.settings.units.to_metres();
     let units = d.settings.units.symbol();
@@ -522,6 +526,19 @@ fn pin_on_the_bores_axis(
         return Ok(());
     }
     let c = bore.centre_v() / scale;
+    if off <= 0.05 * bore.radius {
+        warnings.push(format!(
+            "the sidecar's {name} is {:.3} {units} off the axis of the bore around it (radius \
+             {:.3} {units}, axis through ({:.3}, {:.3}, {:.3}) {units}): l and the bore radius \
+             are measured from the pin as given",
+            off / scale,
+            bore.radius / scale,
+            c.x,
+            c.y,
+            c.z
+        ));
+        return Ok(());
+    }
     bail!(
         "the sidecar's {name} is {:.3} {units} off the axis of the bore around it (radius {:.3} \
          {units}, axis through ({:.3}, {:.3}, {:.3}) {units}): correct the pin centre in the \

@@ -49,7 +49,12 @@ pub struct FileLabel {
 /// line, where known, goes before the message (`file:line: …`).
 fn describe(labels: &[FileLabel], k: usize, what: &str) -> String {
     labels.get(k).map_or_else(
-        || format!("the {}. {what} of the file", k + 1),
+        || {
+            format!(
+                "{what} {} (counting the file's tetrahedra and their nodes only)",
+                k + 1
+            )
+        },
         |l| format!("{what} {}", l.id),
     )
 }
@@ -85,7 +90,14 @@ impl RawVolume {
             node_labels,
             tet_labels,
         } = self;
-        if let Some(k) = nodes.iter().position(|p| !p.iter().all(|v| v.is_finite())) {
+        // a node no tetrahedron uses is dropped below, whatever it holds (as meshio's path does)
+        let mut used = vec![false; nodes.len()];
+        for n in tet10.iter().flatten().chain(tet4.iter().flatten()) {
+            used[*n] = true;
+        }
+        if let Some(k) =
+            (0..nodes.len()).find(|&k| used[k] && !nodes[k].iter().all(|v| v.is_finite()))
+        {
             return Err(FemError::Parse {
                 path: path.to_path_buf(),
                 line: node_labels.get(k).map_or(0, |l| l.line),

@@ -344,21 +344,26 @@ fn design_section(s: &mut String, r: &RankRow, out: &Path) {
             "the judged max von Mises at each crank angle",
         );
     }
+    // only the files of the stages this study reports (an earlier study's stay for its cache)
+    let (fem, cycle) = (r.fem.is_some(), r.cycle.is_some());
     let links: Vec<String> = [
-        ("pin_force.csv", "pin-force history (CSV)"),
+        ("pin_force.csv", "pin-force history (CSV)", true),
         (
             "cycle.csv",
             "stress and reactions over the revolution (CSV)",
+            cycle,
         ),
-        ("fem_fx.vtu", "F_x field (ParaView)"),
-        ("fem_fy.vtu", "F_y field (ParaView)"),
+        ("fem_fx.vtu", "F_x field (ParaView)", fem),
+        ("fem_fy.vtu", "F_y field (ParaView)", fem),
         (
             "cycle.vtu",
             "max over the cycle and fatigue factor (ParaView)",
+            cycle,
         ),
     ]
     .iter()
-    .filter_map(|(f, t)| link(out, &format!("{dir}/{f}"), t))
+    .filter(|(_, _, reported)| *reported)
+    .filter_map(|(f, t, _)| link(out, &format!("{dir}/{f}"), t))
     .collect();
     if !links.is_empty() {
         let _ = writeln!(s, "<p>Files: {}</p>", links.join(" · "));

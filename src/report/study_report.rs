@@ -51,10 +51,30 @@ pub fn write_reports(results: &StudyResults, out: &Path) -> Result<Vec<PathBuf>>
         .tempdir_in(out)
         .with_context(|| format!("{}: cannot write the reports there", out.display()))?;
     let made = write_report_files(results, staging.path())?;
+    // every file made (timings.json too, which the list of reports leaves out) goes in: first
+    // checked that nothing is in the way, then the designs' folders, the top-level files last
+    let mut moves: Vec<(PathBuf, PathBuf)> = files_under(staging.path())?
+        .into_iter()
+        .map(|f| {
+            let target = out.join(f.strip_prefix(staging.path())?);
+            Ok((f, target))
+        })
+        .collect::<Result<_>>()?;
+    for (_, target) in &moves {
+        if target.is_dir() {
+            anyhow::bail!("{}: a folder is in the way of a report", target.display());
+        }
+        let mut folder = target.parent();
+        while let Some(f) = folder.filter(|f| *f != out) {
+            if f.exists() && !f.is_dir() {
+                anyhow::bail!("{}: a file is in the way of a design's folder", f.display());
+            }
+            folder = f.parent();
+        }
+    }
     remove_stale_stage_files(results, out)?;
-    // every file made (timings.json too, which the list of reports leaves out) goes in
-    for file in files_under(staging.path())? {
-        let target = out.join(file.strip_prefix(staging.path())?);
+    moves.sort_by_key(|(_, target)| std::cmp::Reverse(target.components().count()));
+    for (file, target) in moves {
         if let Some(folder) = target.parent() {
             std::fs::create_dir_all(folder)
                 .with_context(|| format!("{}: cannot create", folder.display()))?;
@@ -214,30 +234,31 @@ fn write_report_files(results: &StudyResults, dest: &Path) -> Result<Vec<PathBuf
 
 /// The files stage 3 and the cycle write into a design's folder (`fields`, and the cycle's table
 /// and plot above).
-const FEM_FILES: [&str; 4] = [
+const STAGE_FILES: [&str; 9] = [
     "fem_fx.vtu",
     "fem_fy.vtu",
     "von_mises_fx.svg",
     "von_mises_fy.svg",
+    "buckling_mode.vtu",
+    "cycle.vtu",
+    "von_mises_cycle.svg",
+    "cycle.csv",
+    "cycle.svg",
 ];
-const CYCLE_FILES: [&str; 4] = ["cycle.vtu", "von_mises_cycle.svg", "cycle.csv", "cycle.svg"];
 
-/// Removes, from the folder of each design this study reports, the stage files of a stage it
-/// did not run or that failed (left by an earlier study, e.g. before a `--skip-fem` one), so that
-/// no file in a design's folder disagrees with `results.json`.
+/// Removes what an earlier study left in a design's folder that now disagrees with
+/// `results.json`: a failed design's stage files (its stages did not finish) and a studied
+/// design's old `failure.log`. A stage this study skipped (`--skip-fem`, the cycle switched off)
+/// keeps its files, which the cache of a study that runs it needs; the index page does not link
+/// them.
 fn remove_stale_stage_files(results: &StudyResults, out: &Path) -> Result<()> {
-    let designs = results
+    let studied = results
         .designs
         .iter()
-        .map(|d| (d.mass.id.clone(), d.fem.is_some(), d.cycle.is_some()));
-    let failed = results.failed.iter().map(|f| (f.id(), false, false));
-    for (id, fem, cycle) in designs.chain(failed) {
+        .map(|d| (d.mass.id.clone(), &["failure.log"][..]));
+    let failed = results.failed.iter().map(|f| (f.id(), &STAGE_FILES[..]));
+    for (id, stale) in studied.chain(failed) {
         let dir = out.join(file_safe(&id));
-        let stale = (!fem)
-            .then_some(&FEM_FILES[..])
-            .into_iter()
-            .chain((!cycle).then_some(&CYCLE_FILES[..]))
-            .flatten();
         for name in stale {
             match std::fs::remove_file(dir.join(name)) {
                 Err(e) if e.kind() != std::io::ErrorKind::NotFound => {

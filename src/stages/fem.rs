@@ -572,7 +572,7 @@ pub fn fem_fixed(
     buckling_n: Option<f64>,
 ) -> Result<FemOutcome> {
     let setup = Setup::new(design, config, true, keep_system)?;
-    setup.check_uniform_size(design, size_mm)?;
+    setup.check_uniform_size(design, size_mm, "size (`--size`, `fem.mesh_size_mm`)")?;
     let mut mesher = setup.mesher(work_dir)?;
     let meshed = mesher
         .fixed(size_mm)
@@ -618,7 +618,11 @@ pub fn fem_adaptive(
     buckling_n: Option<f64>,
 ) -> Result<FemOutcome> {
     let setup = Setup::new(design, config, true, keep_system)?;
-    setup.check_uniform_size(design, settings.initial_size_mm)?;
+    setup.check_uniform_size(
+        design,
+        settings.initial_size_mm,
+        "first mesh of the adaptive loop (`fem.initial_size_mm`, with `fem.max_size_mm` at least as large)",
+    )?;
     let mut mesher = setup.mesher(work_dir)?;
     let facets = FacetScale::from_edges(setup.edges(), &setup.surface.vertices, 2.0);
     // an STL's facets set a floor below which refinement resolves the facets, not the part; the
@@ -838,23 +842,24 @@ fn check_mesh_is_the_designs(mesh: &TetMesh, surface: &RodFrameSurface) -> Resul
 /// from below.
 const UNIFORM_MESH_DOFS_PER_CELL: f64 = 30.0;
 
-/// The largest uniform mesh stage 3 starts: about what a direct solve's factor holds in this
-/// machine's memory (design 1 at 2 mm, about 1.7 M DOFs, factorises in a few GB).
-pub const UNIFORM_MESH_MAX_DOFS: f64 = 5e6;
+/// The largest uniform mesh stage 3 starts: far beyond a rod's useful meshes (design 1 at 2 mm
+/// has about 1.7 M DOFs, at 1 mm about 14 M), and far below a rod read in the wrong units (a
+/// centimetre file read as millimetres makes its 5 mm mesh 1000 times larger, 1.1e8 DOFs).
+pub const UNIFORM_MESH_MAX_DOFS: f64 = 2e7;
 
 impl Setup {
     /// Refuses, before gmsh starts, a uniform mesh of `size_mm` that would be far beyond what can
     /// be solved: a size meant for another part, or a design read in the wrong units (a
     /// millimetre rod read as metres is 1e9 times its volume).
-    fn check_uniform_size(&self, design: &LoadedDesign, size_mm: f64) -> Result<()> {
+    /// `knob` names the setting that chose the size.
+    fn check_uniform_size(&self, design: &LoadedDesign, size_mm: f64, knob: &str) -> Result<()> {
         let v = self.surface.volume_mm3();
         let dofs = UNIFORM_MESH_DOFS_PER_CELL * v / size_mm.powi(3);
         if dofs > UNIFORM_MESH_MAX_DOFS {
             anyhow::bail!(
                 "{}: a uniform {size_mm} mm mesh of this part ({v:.3e} mm³, {:.1} mm between the \
-                 pins) would have about {dofs:.1e} DOFs, beyond the {UNIFORM_MESH_MAX_DOFS:.0e} a \
-                 direct solve holds in memory: give a larger size, or check the units (sidecar \
-                 `units`, now {})",
+                 pins) would have about {dofs:.1e} DOFs, beyond the {UNIFORM_MESH_MAX_DOFS:.0e} \
+                 stage 3 starts: check the units (sidecar `units`, now {}), or give a larger {knob}",
                 self.context,
                 self.surface.centre_distance_mm,
                 design.settings.units.symbol()
@@ -877,7 +882,7 @@ pub fn fem_refinement(
     // meshed in the rod frame, mm, as stage 3 meshes (any units and pose)
     let setup = Setup::new(design, config, true, false)?;
     for &size in sizes_mm {
-        setup.check_uniform_size(design, size)?;
+        setup.check_uniform_size(design, size, "`--refine` size")?;
     }
     let mesher = setup.mesher(work_dir)?;
     Ok(refinement_study(

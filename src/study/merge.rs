@@ -94,6 +94,16 @@ pub fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<StudyResults> {
     if dirs.is_empty() {
         bail!("no shard folders given");
     }
+    // the merged reports must not overwrite a shard's own record
+    let canonical = |p: &Path| std::fs::canonicalize(p).ok();
+    if let Some(o) = canonical(out)
+        && let Some(d) = dirs.iter().find(|d| canonical(d).as_ref() == Some(&o))
+    {
+        bail!(
+            "{}: --out is one of the shards; merge into another folder",
+            d.display()
+        );
+    }
     let shards: Vec<(PathBuf, ShardFile)> = dirs
         .iter()
         .map(|d| read_shard(d).map(|s| (d.clone(), s)))
@@ -130,6 +140,21 @@ pub fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<StudyResults> {
         .map(|(d, s)| (d.clone(), s.shard.clone().expect("checked on reading")))
         .collect();
     check_complete(&records)?;
+    // the shards of one study read one designs folder (sweeps name their rods alike)
+    let (first_dir, first_record) = &records[0];
+    if let Some((dir, r)) = records
+        .iter()
+        .find(|(_, r)| r.designs_folder != first_record.designs_folder)
+    {
+        bail!(
+            "{} studied the designs in {}, {} those in {}: the shards of one study read one \
+             designs folder",
+            first_dir.display(),
+            first_record.designs_folder,
+            dir.display(),
+            r.designs_folder
+        );
+    }
     let config = first.config;
     let mut results = StudyResults {
         program_version: version.into(),
@@ -157,11 +182,13 @@ pub fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<StudyResults> {
             });
         }
         for mut f in s.failed {
-            if let Some(m) = &f.mass {
-                copy_files(&dir.join(file_safe(&m.id)), &out.join(file_safe(&m.id)))?;
-                if f.dynamics.is_some() {
-                    f.history = history_of(m, &config).ok();
-                }
+            // its folder (a failure.log, the stages that passed) whatever stage failed
+            let id = file_safe(&f.id());
+            copy_files(&dir.join(&id), &out.join(&id))?;
+            if let Some(m) = &f.mass
+                && f.dynamics.is_some()
+            {
+                f.history = history_of(m, &config).ok();
             }
             results.failed.push(f);
         }

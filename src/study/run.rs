@@ -93,6 +93,7 @@ pub fn run_study(
                 shard: sh,
                 all_designs: all,
                 designs,
+                designs_folder: options.designs.display().to_string(),
             };
             (mine, Some(record))
         }

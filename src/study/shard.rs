@@ -35,6 +35,11 @@ impl std::str::FromStr for Shard {
         if count == 0 || index == 0 || index > count {
             return Err(format!("a shard K/N needs 1 ≤ K ≤ N, got `{s}`"));
         }
+        if count > MAX_SHARDS {
+            return Err(format!(
+                "a study splits into at most {MAX_SHARDS} shards, got `{s}`"
+            ));
+        }
         Ok(Shard { index, count })
     }
 }
@@ -44,6 +49,10 @@ impl std::fmt::Display for Shard {
         write!(f, "{}/{}", self.index, self.count)
     }
 }
+
+/// The most shards a study splits into (a Slurm array of this many tasks is already far more
+/// than designs a sweep studies at once; `merge` lists the shards it misses).
+pub const MAX_SHARDS: usize = 10_000;
 
 /// The shard (1-based) design `id` belongs to among `count`.
 pub fn shard_of(id: &str, count: usize) -> usize {
@@ -77,6 +86,10 @@ pub struct ShardRecord {
     pub all_designs: Vec<String>,
     /// The ids this shard computed (or tried to), sorted.
     pub designs: Vec<String>,
+    /// The designs folder as `--designs` gave it: the shards of one study read one folder
+    /// (empty in records written before 0.3.0's session 26).
+    #[serde(default)]
+    pub designs_folder: String,
 }
 
 /// Checks a set of shard records for completeness: the same N, every index once, every design of
@@ -216,6 +229,7 @@ mod tests {
                     shard: Shard { index: k, count: 2 },
                     all_designs: vec!["a".into(), "b".into(), "c".into()],
                     designs: designs.iter().map(|s| s.to_string()).collect(),
+                    designs_folder: "designs".into(),
                 },
             )
         };
