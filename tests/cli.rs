@@ -402,3 +402,16 @@ fn table_5_1_json_rows_name_their_scene() {
         }
     }
 }
+
+/// `pipeline SCRIPT` runs a script of pipeline/ by its name, never a path elsewhere.
+#[test]
+fn pipeline_runs_only_its_own_scripts() {
+    for script in ["../Cargo.toml", "/etc/passwd", "make_designs"] {
+        let o = rodstudy(&["pipeline", script], &[]);
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            o.status.code() == Some(2) && e.contains("a Python script in pipeline/"),
+            "{script}: {e}"
+        );
+    }
+}

@@ -21,6 +21,16 @@ pub fn setup() -> Result<i32> {
 }
 
 pub fn run(args: PipelineArgs) -> Result<i32> {
+    // a script of the pipeline folder by its name, nothing elsewhere
+    let plain = std::path::Path::new(&args.script)
+        .file_name()
+        .is_some_and(|n| n == args.script.as_str());
+    if !plain || !args.script.ends_with(".py") {
+        bail!(
+            "{}: give the name of a Python script in pipeline/ (e.g. make_designs.py), not a path",
+            args.script
+        );
+    }
     let script = pipeline_script(&args.script);
     if !script.is_file() {
         bail!("{}: no such pipeline script", script.display());
