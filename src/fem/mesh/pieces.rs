@@ -53,11 +53,7 @@ pub fn pieces(mesh: &TetMesh) -> (Vec<Piece>, Vec<usize>) {
         }
         let k = index[root];
         let x = mesh.element_coords(e);
-        let d = |i: usize| std::array::from_fn::<f64, 3, _>(|j| x[i][j] - x[0][j]);
-        let (a, b, c) = (d(1), d(2), d(3));
-        let v = (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
-            + a[2] * (b[0] * c[1] - b[1] * c[0]))
-            / 6.0;
+        let v = super::structured::signed_volume(mesh.nodes(), &[el[0], el[1], el[2], el[3]]) / 6.0;
         out[k].elements += 1;
         out[k].volume_m3 += v;
         for j in 0..3 {

@@ -36,7 +36,9 @@ pub fn tet4_to_tet10(mut nodes: Vec<[f64; 3]>, tets: &[[usize; 4]]) -> Result<Te
     TetMesh::new(nodes, elements)
 }
 
-fn signed_volume(nodes: &[[f64; 3]], c: &[usize; 4]) -> f64 {
+/// Six times the signed volume of the tetrahedron on corners `c` of `nodes` (the triple product
+/// of its edges from corner 0; positive for corners 1-2-3 anticlockwise seen from corner 4).
+pub(crate) fn signed_volume(nodes: &[[f64; 3]], c: &[usize; 4]) -> f64 {
     let d = |i: usize| std::array::from_fn::<f64, 3, _>(|j| nodes[c[i]][j] - nodes[c[0]][j]);
     let (a, b, e) = (d(1), d(2), d(3));
     a[0] * (b[1] * e[2] - b[2] * e[1]) - a[1] * (b[0] * e[2] - b[2] * e[0])
