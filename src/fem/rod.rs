@@ -71,6 +71,10 @@ pub struct RodOptions {
     /// the geometry check of [`super::smooth`]), reused where it fits.
     #[serde(skip)]
     pub reuse_symbolic: Option<super::solver::SymbolicFactor>,
+    /// The mesh given to [`solve_rod_on`] is the half z ≥ c of a mirror-symmetric rod, with its
+    /// face on the plane z = c (m, rod frame); `None`: the whole rod.
+    #[serde(default)]
+    pub mirror_plane_z_m: Option<f64>,
 }
 
 /// Results of one load case. Stresses in MPa, lengths in mm, forces in N.
@@ -283,6 +287,10 @@ pub struct FemResult {
     /// through the STL's vertices ([`super::smooth`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub geometry_check: Option<super::smooth::GeometryCheckRecord>,
+    /// Solved on the half model of a mirror-symmetric rod and mirrored ([`solve_rod_on`]): `nodes`
+    /// and `elements` are the whole's, `dofs`, `equations`, `nnz_k`, `nnz_l` the half's system.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub half_model: Option<HalfModel>,
     /// How the pin force is spread over the loaded bore (absent: uniform; `cosine`: a cosine
     /// bearing pressure on the pressed half).
     #[serde(default, skip_serializing_if = "BoreLoad::is_uniform")]
@@ -356,6 +364,110 @@ pub fn solve_rod_fields(
     )
 }
 
+/// [`solve_rod_fields`] on `mesh`, or, when `options` names a symmetry plane
+/// ([`RodOptions::mirror_plane_z_m`]), on the half model `mesh` is: solved with half the pin loads
+/// and u_z = 0 on the plane, then mirrored into the whole ([`super::mesh::mirror`]), on which the
+/// stresses, estimates and peaks are formed as for any mesh. Returns the mesh the solution is on
+/// (the whole, for a half model).
+pub fn solve_rod_on(
+    mesh: TetMesh,
+    material: &Material,
+    bores: &BoreSpec,
+    force_n: f64,
+    options: &RodOptions,
+) -> Result<(TetMesh, RodSolution)> {
+    let Some(c) = options.mirror_plane_z_m else {
+        let solution = solve_rod_fields(&mesh, material, bores, force_n, options)?;
+        return Ok((mesh, solution));
+    };
+    let (lo, hi) = mesh.bounding_box();
+    let extent = (0..3).map(|j| hi[j] - lo[j]).fold(0.0, f64::max);
+    let m = super::mesh::mirror::mirror(&mesh, c, MIRROR_PLANE_TOLERANCE_REL * extent)?;
+    let held: Vec<usize> = m.plane_nodes.iter().map(|&n| 3 * n + 2).collect();
+    let half = static_cases(&mesh, material, bores, force_n, options, 0.5, &held)?;
+    let whole = mirrored_static(&m, half, bores)?;
+    let mut solution = rod_fields(whole, options)?;
+    solution.result.half_model = Some(HalfModel {
+        plane_z_mm: c * 1e3,
+        nodes: mesh.n_nodes(),
+        elements: mesh.n_elements(),
+        plane_nodes: m.plane_nodes.len(),
+    });
+    Ok((m.whole, solution))
+}
+
+/// Nodes of a half model within this fraction of its extent from the symmetry plane, on a face
+/// there, are the plane's.
+pub const MIRROR_PLANE_TOLERANCE_REL: f64 = 1e-7;
+
+/// The static solution of a half model (`half`, on the half of `m`) as the whole's: the
+/// displacements mirrored, the loads and reactions of both halves, the bores found on the whole.
+fn mirrored_static<'a>(
+    m: &'a super::mesh::mirror::MirroredMesh,
+    half: RodStatic<'_>,
+    bores: &BoreSpec,
+) -> Result<RodStatic<'a>> {
+    let (loaded, fixed, _, _) = bores_and_direction(&m.whole, bores)?;
+    let loads = half
+        .loads
+        .iter()
+        .map(|l| {
+            let forces = m.mirror_forces(&l.forces);
+            let mut resultant_n = [0.0; 3];
+            for (d, f) in forces.iter().enumerate() {
+                resultant_n[d % 3] += f;
+            }
+            SurfaceLoad {
+                forces,
+                area_m2: 2.0 * l.area_m2,
+                traction_pa: l.traction_pa,
+                resultant_n,
+                resultant_error_rel: l.resultant_error_rel,
+            }
+        })
+        .collect();
+    let sol = StaticSolution {
+        displacements: half
+            .sol
+            .displacements
+            .iter()
+            .map(|u| m.mirror_vector(u))
+            .collect(),
+        reactions: half
+            .sol
+            .reactions
+            .iter()
+            .map(|r| m.mirror_forces(r))
+            .collect(),
+        ..half.sol
+    };
+    Ok(RodStatic {
+        mesh: &m.whole,
+        material: half.material,
+        bores: half.bores,
+        t_all: half.t_all,
+        loaded,
+        fixed,
+        cases: half.cases,
+        loads,
+        sol,
+        system: None,
+    })
+}
+
+/// A solution made on a half model and mirrored ([`solve_rod_on`]): what was solved.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct HalfModel {
+    /// The symmetry plane z = c in the rod frame, mm.
+    pub plane_z_mm: f64,
+    /// Nodes of the half (the solved system has 3 per node, less the supports).
+    pub nodes: usize,
+    /// Elements of the half.
+    pub elements: usize,
+    /// Nodes on the symmetry plane (u_z = 0).
+    pub plane_nodes: usize,
+}
+
 /// The first half of [`solve_rod_fields`]: the bores, the two pin loads and the static solution
 /// of both cases. What it does not read of `options` (the fixed band, the singular edges and their
 /// band, the fillet-kink count) [`rod_fields`] reads, so that a caller can work those out while K
@@ -381,6 +493,20 @@ pub fn solve_rod_static<'a>(
     force_n: f64,
     options: &RodOptions,
 ) -> Result<RodStatic<'a>> {
+    static_cases(mesh, material, bores, force_n, options, 1.0, &[])
+}
+
+/// [`solve_rod_static`] with the pin loads scaled by `load_share` (½ on a half model) and the
+/// DOFs `held` fixed besides bore B's (u_z on a half model's symmetry plane).
+fn static_cases<'a>(
+    mesh: &'a TetMesh,
+    material: &Material,
+    bores: &BoreSpec,
+    force_n: f64,
+    options: &RodOptions,
+    load_share: f64,
+    held: &[usize],
+) -> Result<RodStatic<'a>> {
     let t_all = Instant::now();
     material.validate()?;
     let fy_force_n = options.fy_force_n.unwrap_or(force_n);
@@ -404,17 +530,24 @@ pub fn solve_rod_static<'a>(
                 &loaded.faces,
                 bores.loaded_centre_m,
                 axis,
-                d.map(|v| v * f),
+                d.map(|v| v * f * load_share),
                 bores.bore_load,
             )
         })
         .collect::<Result<Vec<_>>>()?;
 
-    let prescribed: Vec<(usize, f64)> = fixed
+    let mut prescribed: Vec<(usize, f64)> = fixed
         .nodes
         .iter()
         .flat_map(|&n| (0..3).map(move |j| (3 * n + j, 0.0)))
         .collect();
+    let fixed_already: std::collections::HashSet<usize> =
+        prescribed.iter().map(|(d, _)| *d).collect();
+    prescribed.extend(
+        held.iter()
+            .filter(|d| !fixed_already.contains(d))
+            .map(|&d| (d, 0.0)),
+    );
     let problem = StaticProblem {
         mesh,
         material: *material,
@@ -583,6 +716,7 @@ pub fn rod_fields(st: RodStatic<'_>, options: &RodOptions) -> Result<RodSolution
         fillet_kink_edges: options.fillet_kink_edges,
         warnings,
         geometry_check: None,
+        half_model: None,
         bore_load: bores.bore_load,
         loaded_bore: (&loaded).into(),
         fixed_bore: (&fixed).into(),
@@ -752,9 +886,99 @@ fn check_one_piece(mesh: &TetMesh, fixed_nodes: &[usize]) -> Result<()> {
 
 #[cfg(test)]
 mod tests {
-    use super::check_one_piece;
+    use super::{RodOptions, check_one_piece};
     use crate::fem::TetMesh;
     use crate::fem::mesh::structured::box_tet10;
+
+    /// A half model solved with half the pin loads and u_z = 0 on its plane, mirrored, is the
+    /// whole model's solution: against the direct solve of the mirrored mesh (the same mesh, the
+    /// same loads) the displacements, peaks, reactions and estimates agree to round-off.
+    #[test]
+    fn a_half_model_mirrored_is_the_whole_model() {
+        use crate::fem::mesh::structured::{TwoEyePlate, two_eye_plate};
+        use crate::fem::{BoreSpec, Material};
+        // the upper half of a 40 mm plate, z ∈ [0, 20] mm, two layers
+        let p = TwoEyePlate {
+            thickness: 0.02,
+            n_z: 2,
+            ..TwoEyePlate::default()
+        };
+        let half = two_eye_plate(&p)
+            .unwrap()
+            .map_nodes(|_, q| [q[0], q[1], q[2] + 0.01])
+            .unwrap();
+        let (material, bores) = (Material::STEEL, BoreSpec::default());
+        let options = RodOptions {
+            mirror_plane_z_m: Some(0.0),
+            fy_force_n: Some(3000.0),
+            ..RodOptions::default()
+        };
+        let (whole, mirrored) =
+            super::solve_rod_on(half.clone(), &material, &bores, 10_000.0, &options).unwrap();
+        let direct = super::solve_rod_fields(
+            &whole,
+            &material,
+            &bores,
+            10_000.0,
+            &RodOptions {
+                mirror_plane_z_m: None,
+                ..options.clone()
+            },
+        )
+        .unwrap();
+        let (lo, hi) = whole.bounding_box();
+        assert_eq!((lo[2], hi[2]), (-0.02, 0.02));
+        let hm = mirrored.result.half_model.as_ref().unwrap();
+        assert_eq!((hm.nodes, hm.elements), (half.n_nodes(), half.n_elements()));
+        assert_eq!(whole.n_elements(), 2 * half.n_elements());
+        assert_eq!(mirrored.result.dofs, 3 * half.n_nodes());
+        let rel = |a: f64, b: f64| (a - b).abs() / b.abs().max(1e-300);
+        for c in 0..2 {
+            let (a, b) = (&mirrored.displacements[c], &direct.displacements[c]);
+            let umax = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let diff = a
+                .iter()
+                .zip(b)
+                .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+            assert!(diff < 1e-9 * umax, "case {c}: {diff:e} of {umax:e}");
+        }
+        for (m, d) in [
+            (&mirrored.result.fx, &direct.result.fx),
+            (&mirrored.result.fy, &direct.result.fy),
+        ] {
+            assert!(
+                rel(
+                    m.max_von_mises_away_from_fixed_mpa,
+                    d.max_von_mises_away_from_fixed_mpa
+                ) < 1e-9
+            );
+            assert!(
+                rel(
+                    m.max_von_mises_unaveraged_mpa,
+                    d.max_von_mises_unaveraged_mpa
+                ) < 1e-9
+            );
+            assert!(rel(m.max_displacement_mm, d.max_displacement_mm) < 1e-9);
+            assert!(rel(m.estimated_error_rel, d.estimated_error_rel) < 1e-6);
+            assert_eq!(m.force_n, d.force_n);
+            for j in 0..3 {
+                assert!(
+                    (m.reaction_n[j] - d.reaction_n[j]).abs() < 1e-6 * d.force_n,
+                    "{:?} {:?}",
+                    m.reaction_n,
+                    d.reaction_n
+                );
+                assert!(
+                    (m.applied_resultant_n[j] - d.applied_resultant_n[j]).abs() < 1e-9 * d.force_n
+                );
+            }
+            assert!(m.reaction_balance_rel < 1e-6);
+        }
+        assert_eq!(
+            format!("{:?}", mirrored.result.loaded_bore),
+            format!("{:?}", direct.result.loaded_bore)
+        );
+    }
 
     #[test]
     fn a_piece_apart_from_the_fixed_bores_is_refused_by_where_it_is() {

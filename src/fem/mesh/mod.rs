@@ -3,6 +3,7 @@
 //!
 //! Element node order: VTK's tetra10 (see [`crate::fem::shape`]).
 
+pub mod mirror;
 pub mod pieces;
 pub mod structured;
 
