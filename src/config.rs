@@ -117,6 +117,30 @@ pub struct FemConfig {
     /// written into `results.json`.
     #[serde(skip_serializing_if = "BoreLoad::is_uniform")]
     pub bore_load: BoreLoad,
+    /// `"off"` (default): the whole rod; `"auto"`: an STL rod symmetric about its mid-plane
+    /// across the pin axis (within [`crate::stages::fem::MIRROR_TOLERANCE_MM`]) is meshed and
+    /// solved as its half with u_z = 0 on the plane, then mirrored (the same answer on the same
+    /// mesh, from half the DOFs; the adaptive loop's meshes differ, docs/fem.md). The default is
+    /// not written into `results.json`.
+    #[serde(skip_serializing_if = "Symmetry::is_off")]
+    pub symmetry: Symmetry,
+}
+
+/// Whether stage 3 uses a rod's mirror symmetry ([`FemConfig::symmetry`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Symmetry {
+    /// Always the whole rod.
+    #[default]
+    Off,
+    /// The half model where the surface is symmetric.
+    Auto,
+}
+
+impl Symmetry {
+    fn is_off(&self) -> bool {
+        *self == Symmetry::Off
+    }
 }
 
 impl FemConfig {
@@ -144,6 +168,7 @@ impl Default for FemConfig {
             youngs_modulus_pa: 210e9,
             poisson_ratio: 0.3,
             bore_load: BoreLoad::Uniform,
+            symmetry: Symmetry::Off,
         }
     }
 }

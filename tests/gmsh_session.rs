@@ -49,7 +49,7 @@ fn a_session_makes_the_meshes_of_fresh_processes_file_for_file() {
         .map(|p| (2.5e-3 + 0.05 * p[0].abs()).min(10e-3))
         .collect();
     let field = dir.path().join("size_field.bin");
-    write_size_field(&field, &first.mesh, &sizes, 1e3).unwrap();
+    write_size_field(&field, &first.mesh, &sizes, 1e3, None).unwrap();
     let second = session
         .mesh(10.0, Some(&field), &served.join("m1"), "rod")
         .unwrap();
@@ -62,7 +62,7 @@ fn a_session_makes_the_meshes_of_fresh_processes_file_for_file() {
         .map(|p| (10e-3 - 0.04 * p[0].abs()).max(3e-3))
         .collect();
     let field2 = dir.path().join("size_field2.bin");
-    write_size_field(&field2, &second.mesh, &sizes, 1e3).unwrap();
+    write_size_field(&field2, &second.mesh, &sizes, 1e3, None).unwrap();
     let third = session
         .mesh(8.0, Some(&field2), &served.join("m2"), "rod")
         .unwrap();

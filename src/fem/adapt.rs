@@ -51,7 +51,7 @@ use super::mesh::{TetMesh, dist};
 use super::recovery::node_elements;
 use super::rod::{
     AdaptiveStep, DEFAULT_FIXED_BAND_M, MeshPhases, RodOptions, RodSolution, StepTimings,
-    solve_rod_fields,
+    solve_rod_on,
 };
 use super::shape::TET10_EDGES;
 
@@ -98,6 +98,9 @@ pub struct MeshAsk<'a> {
     pub size_m: f64,
     /// The previous mesh and the size wanted at each of its nodes, m.
     pub size_map: Option<(&'a TetMesh, &'a [f64])>,
+    /// A half model's symmetry plane z = c (m): the mesh is of the half above it, and the size
+    /// map's elements below it are not needed.
+    pub above_z_m: Option<f64>,
 }
 
 /// What makes the meshes of the loop: the first (uniform) and each one from a size map. The gmsh
@@ -308,12 +311,14 @@ pub fn adaptive_rod(
                 opts.initial_size_m
             },
             size_map,
+            above_z_m: rod_opts.mirror_plane_z_m,
         };
         let (mesh, secs) = mesher.mesh(&ask)?;
         let mesh_phases = mesher.last_phases();
         mesh_s += secs;
         let last = iteration + 1 >= opts.max_iterations;
-        let sol = solve_rod_fields(&mesh, material, bores, force_n, &rod_opts)?;
+        // a half model's mesh is mirrored into the whole here: everything below sees the whole
+        let (mesh, sol) = solve_rod_on(mesh, material, bores, force_n, &rod_opts)?;
         let sizes = element_sizes(&mesh);
         let elems_of = node_elements(&mesh);
         let cases = [&sol.result.fx, &sol.result.fy];
@@ -337,8 +342,12 @@ pub fn adaptive_rod(
             estimates[c] = e;
             steps[c].push(AdaptiveStep {
                 iteration,
-                elements: mesh.n_elements(),
-                dofs: mesh.n_dofs(),
+                elements: sol
+                    .result
+                    .half_model
+                    .as_ref()
+                    .map_or(mesh.n_elements(), |h| h.elements),
+                dofs: sol.result.dofs,
                 peak_mpa: peak_pa * 1e-6,
                 estimated_error_rel: e,
                 size_at_peak_mm: h_here * 1e3,
@@ -370,9 +379,13 @@ pub fn adaptive_rod(
             None
         };
         let new_sizes = if stop.is_none() {
-            Some(refine_sizes(
+            let mut ns = refine_sizes(
                 &mesh, &sol, &sizes, &elems_of, &estimates, &targets, opts, floor,
-            ))
+            );
+            if let Some(source) = &sol.mirror_source {
+                mirror_min(&mut ns, source);
+            }
+            Some(ns)
         } else {
             None
         };
@@ -431,6 +444,19 @@ pub fn adaptive_rod(
         }
         next_sizes = Some((mesh, new_sizes.expect("not stopped")));
         iteration += 1;
+    }
+}
+
+/// A half model's size map on the whole mesh made symmetric: a node and its mirror image both
+/// get the smaller of their two sizes. The next mesh is the half's, so what the image side asks
+/// for (a peak that landed on the image) must reach the half's node.
+fn mirror_min(sizes: &mut [f64], source: &[usize]) {
+    for (n, &s) in source.iter().enumerate() {
+        if n != s {
+            let m = sizes[n].min(sizes[s]);
+            sizes[n] = m;
+            sizes[s] = m;
+        }
     }
 }
 

@@ -151,9 +151,9 @@ pub struct LoadCaseResult {
 pub struct AdaptiveStep {
     /// 0 for the initial mesh.
     pub iteration: usize,
-    /// Elements.
+    /// Elements (of the half, for a half model: the mesh that was made and solved).
     pub elements: usize,
-    /// DOFs.
+    /// DOFs of the system solved (of the half, for a half model).
     pub dofs: usize,
     /// The judged peak (max von Mises away from the fixed bore), MPa.
     pub peak_mpa: f64,
@@ -336,6 +336,9 @@ pub struct RodSolution {
     pub buckling: Option<super::buckling::BucklingMode>,
     /// The factorised K of the static cases, when [`RodOptions::keep_system`] asked for it.
     pub system: Option<Arc<FactorisedSystem>>,
+    /// A half model's solution ([`solve_rod_on`]): for each node of the whole, the node of the
+    /// half it is or is the image of (the first `half_model.nodes` are the half's own).
+    pub mirror_source: Option<Vec<usize>>,
 }
 
 /// Analyses a rod: see the module documentation. `force_n` > 0 is the magnitude of both cases
@@ -393,6 +396,7 @@ pub fn solve_rod_on(
         elements: mesh.n_elements(),
         plane_nodes: m.plane_nodes.len(),
     });
+    solution.mirror_source = Some(m.source);
     Ok((m.whole, solution))
 }
 
@@ -744,6 +748,7 @@ pub fn rod_fields(st: RodStatic<'_>, options: &RodOptions) -> Result<RodSolution
         estimates: [e0, e1],
         buckling: None,
         system,
+        mirror_source: None,
     };
     Ok(solution)
 }

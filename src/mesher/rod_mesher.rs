@@ -212,7 +212,7 @@ impl Mesher for GmshRodMesher {
         let served = if self.session_wanted {
             let field = match ask.size_map {
                 Some((m, s)) => {
-                    write_size_field(&field_path, m, s, 1e3)?;
+                    write_size_field(&field_path, m, s, 1e3, ask.above_z_m)?;
                     Some(field_path.as_path())
                 }
                 None => None,
@@ -228,7 +228,7 @@ impl Mesher for GmshRodMesher {
                 let field = match ask.size_map {
                     Some((m, s)) => {
                         let scaled: Vec<f64> = s.iter().map(|v| v * scale).collect();
-                        write_size_field(&field_path, m, &scaled, 1e3)?;
+                        write_size_field(&field_path, m, &scaled, 1e3, ask.above_z_m)?;
                         Some(field_path.as_path())
                     }
                     None => None,

@@ -13,8 +13,16 @@ use crate::fem::TetMesh;
 use crate::fem::error::{FemError, Result};
 
 /// Writes the size map `sizes` (one per mesh node, only corner nodes are read) of `mesh` to
-/// `path`. Coordinates and sizes are multiplied by `scale` (1e3: metres → the mesher's mm).
-pub fn write_size_field(path: &Path, mesh: &TetMesh, sizes: &[f64], scale: f64) -> Result<()> {
+/// `path`. Coordinates and sizes are multiplied by `scale` (1e3: metres → the mesher's mm). With
+/// `above_z` (m), the elements wholly at or below that plane are left out (a half model is meshed
+/// above it: gmsh never evaluates the field below, and searches half the tetrahedra).
+pub fn write_size_field(
+    path: &Path,
+    mesh: &TetMesh,
+    sizes: &[f64],
+    scale: f64,
+    above_z: Option<f64>,
+) -> Result<()> {
     if sizes.len() != mesh.n_nodes() {
         return Err(FemError::InvalidInput(format!(
             "size field has {} values for {} nodes",
@@ -33,6 +41,11 @@ pub fn write_size_field(path: &Path, mesh: &TetMesh, sizes: &[f64], scale: f64) 
     }
     let mut bytes = Vec::with_capacity(mesh.n_elements() * 16 * 8);
     for el in mesh.elements() {
+        if let Some(c) = above_z
+            && el[..4].iter().all(|&n| mesh.nodes()[n][2] <= c)
+        {
+            continue;
+        }
         for j in 0..3 {
             for &n in &el[..4] {
                 bytes.extend_from_slice(&(mesh.nodes()[n][j] * scale).to_le_bytes());
@@ -62,7 +75,7 @@ mod tests {
             .collect();
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("f.bin");
-        write_size_field(&path, &mesh, &sizes, 1e3).unwrap();
+        write_size_field(&path, &mesh, &sizes, 1e3, None).unwrap();
         let bytes = std::fs::read(&path).unwrap();
         let v: Vec<f64> = bytes
             .chunks_exact(8)
@@ -81,6 +94,15 @@ mod tests {
         }
         let mut bad = sizes.clone();
         bad[0] = 0.0;
-        assert!(write_size_field(&path, &mesh, &bad, 1e3).is_err());
+        assert!(write_size_field(&path, &mesh, &bad, 1e3, None).is_err());
+        // above z = 0.5 mm: the elements of the upper half of the cube's six only
+        write_size_field(&path, &mesh, &sizes, 1e3, Some(0.5e-3)).unwrap();
+        let above = mesh
+            .elements()
+            .iter()
+            .filter(|el| el[..4].iter().any(|&n| mesh.nodes()[n][2] > 0.5e-3))
+            .count();
+        assert!(above > 0 && above < mesh.n_elements());
+        assert_eq!(std::fs::read(&path).unwrap().len(), 16 * 8 * above);
     }
 }

@@ -25,12 +25,12 @@ use super::records::{
     AdaptiveSummary, DesignDynamics, DesignFem, LoadedDesign, MeshSummary, StageMesh,
 };
 use super::rod_surface::{RodFrameSurface, rod_frame_surface};
-use crate::config::{FemConfig, StudyConfig};
+use crate::config::{FemConfig, StudyConfig, Symmetry};
 use crate::fem::adapt::{AdaptOptions, adaptive_rod};
 use crate::fem::buckling::{BucklingMode, BucklingOptions, BucklingSolution};
 use crate::fem::facets::{FacetScale, MAX_FILLET_RADIUS_MM, SurfaceEdges};
 use crate::fem::refinement::{RefinementStudy, refinement_study};
-use crate::fem::rod::{RodSolution, rod_fields, solve_rod_fields, solve_rod_static};
+use crate::fem::rod::{RodSolution, rod_fields, solve_rod_on, solve_rod_static};
 use crate::fem::rod_buckling::rod_buckling;
 use crate::fem::smooth::{SmoothSurface, geometry_check};
 use crate::fem::statics::FactorisedSystem;
@@ -293,6 +293,9 @@ pub fn apply_buckling(
 /// and the options of the rod analysis.
 struct Setup {
     surface: RodFrameSurface,
+    /// The half model's surface, when the rod is mirror-symmetric ([`half_surface`]): what gmsh
+    /// meshes instead of `surface`.
+    half: Option<HalfSurface>,
     /// The exact geometry in the rod frame, for a STEP design.
     step: Option<StepInRodFrame>,
     bores: BoreSpec,
@@ -326,7 +329,13 @@ impl Setup {
             .with_context(|| context.clone())?
             .and_then(|d| d.peak_transverse_n);
         let surface = rod_frame_surface(design, for_gmsh);
+        let half = if for_gmsh && design.format.step().is_none() {
+            half_surface(&surface, config.fem.symmetry)
+        } else {
+            None
+        };
         let rod = RodOptions {
+            mirror_plane_z_m: half.as_ref().map(|h| h.plane_z_mm * 1e-3),
             fixed_band_m: Some(config.fem.fixed_band_mm * 1e-3),
             singular_band_m: Some(config.fem.singular_band_mm * 1e-3),
             fy_force_n,
@@ -356,6 +365,7 @@ impl Setup {
             step,
             bores,
             surface,
+            half,
             material: Material::from(&config.fem),
             edges: None,
             keep_system,
@@ -414,11 +424,15 @@ impl Setup {
     /// geometry of a STEP design (curved tet10).
     fn mesher(&self, work_dir: &Path) -> Result<GmshRodMesher> {
         let python = python().with_context(|| self.context.clone())?;
+        let (stl_bytes, digest) = match &self.half {
+            Some(h) => (&h.stl_bytes, &h.digest),
+            None => (&self.surface.stl_bytes, &self.surface.digest),
+        };
         let mesher = GmshRodMesher::new(
             &python,
             &pipeline_script(MESHER_SCRIPT),
-            &self.surface.stl_bytes,
-            &self.surface.digest,
+            stl_bytes,
+            digest,
             work_dir,
             &self.context[..self.context.len() - ": FEM".len()],
         )
@@ -515,9 +529,11 @@ impl Setup {
                 self.edges(),
                 2.0,
             );
+            // the whole mesh, curved
             let rod = RodOptions {
                 keep_system: false,
                 reuse_symbolic: symbolic,
+                mirror_plane_z_m: None,
                 ..self.rod.clone()
             };
             let (checked, buckled) = rayon::join(
@@ -556,6 +572,71 @@ impl Setup {
     }
 }
 
+/// The half model's surface: the rod-frame surface's half z ≥ c, capped in the plane, as the
+/// binary STL gmsh meshes.
+struct HalfSurface {
+    stl_bytes: Vec<u8>,
+    /// SHA-256 of the STL bytes (keys the classified-surface cache).
+    digest: String,
+    /// The symmetry plane z = c, mm (rod frame).
+    plane_z_mm: f64,
+}
+
+/// Largest distance of a vertex's mirror image from the rod-frame surface for the rod to count as
+/// mirror-symmetric about its mid-plane across the pin axis, mm (the five designs' exports: 0.017–0.024
+/// mm, their tessellations' chordal error). Also the largest move of a vertex onto the plane when
+/// the surface is halved.
+pub const MIRROR_TOLERANCE_MM: f64 = 0.05;
+
+/// Environment variable overriding `[fem] symmetry` (for comparing the two routes, e.g. in
+/// `bench fem --adaptive`): `1` as `"auto"`, `0` as `"off"`.
+pub const HALF_MODEL_VAR: &str = "RODSTUDY_HALF_MODEL";
+
+/// The half of `surface` (rod frame, mm) when the rod is mirror-symmetric about the plane halving
+/// its thickness ([`crate::geometry::mirror_symmetry`]) and `symmetry` allows; `None` otherwise,
+/// or when the halved surface is not a valid closed solid of half the volume (then the whole rod
+/// is meshed, as without symmetry).
+fn half_surface(surface: &RodFrameSurface, symmetry: Symmetry) -> Option<HalfSurface> {
+    use crate::geometry::primitives::{binary_stl, to_soup};
+    use sha2::Digest;
+    let symmetry = match std::env::var(HALF_MODEL_VAR).as_deref() {
+        Ok("1") => Symmetry::Auto,
+        Ok("0") => Symmetry::Off,
+        _ => symmetry,
+    };
+    if symmetry == Symmetry::Off {
+        return None;
+    }
+    let mesh = crate::geometry::IndexedMesh {
+        vertices: surface
+            .vertices
+            .iter()
+            .map(|v| nalgebra::Vector3::from(*v))
+            .collect(),
+        triangles: surface.triangles.clone(),
+    };
+    let fit = crate::geometry::mirror_symmetry::mirror_fit_z(&mesh)?;
+    if !fit.is_symmetric(MIRROR_TOLERANCE_MM) {
+        return None;
+    }
+    let half = crate::geometry::half_solid::half_above(&mesh, fit.z, MIRROR_TOLERANCE_MM).ok()?;
+    let half = crate::geometry::validate::validate(half).ok()?;
+    let ratio = crate::geometry::mass_properties::signed_volume(&half.mesh)
+        / crate::geometry::mass_properties::signed_volume(&mesh);
+    if !half.warnings.is_empty() || (ratio - 0.5).abs() > 1e-3 {
+        return None;
+    }
+    let stl_bytes = binary_stl(&to_soup(&half.mesh));
+    Some(HalfSurface {
+        digest: sha2::Sha256::digest(&stl_bytes)
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect(),
+        stl_bytes,
+        plane_z_mm: fit.z,
+    })
+}
+
 /// The mesher's fallbacks of a run, for `mesh.fallback` (`None` when no mesh needed one).
 fn joined(fallbacks: &[String]) -> Option<String> {
     (!fallbacks.is_empty()).then(|| fallbacks.join("; "))
@@ -577,21 +658,21 @@ pub fn fem_fixed(
     let meshed = mesher
         .fixed(size_mm)
         .with_context(|| setup.context.clone())?;
-    let mut solution = solve_rod_fields(
-        &meshed.mesh,
+    let r: &MeshReport = &meshed.report;
+    let (mesh, mut solution) = solve_rod_on(
+        meshed.mesh,
         &setup.material,
         &setup.bores,
         force_n,
         &setup.rod,
     )
     .with_context(|| setup.context.clone())?;
-    let buckling_run = setup.add_geometry_error(&meshed.mesh, &mut solution, force_n, buckling_n);
-    let r: &MeshReport = &meshed.report;
+    let buckling_run = setup.add_geometry_error(&mesh, &mut solution, force_n, buckling_n);
     let summary = MeshSummary {
         source: setup.source().into(),
         size_mm: Some(r.size_mm),
-        elements: r.elements,
-        nodes: r.nodes,
+        elements: mesh.n_elements(),
+        nodes: mesh.n_nodes(),
         min_sicn: Some(r.min_sicn),
         min_scaled_jacobian: Some(r.min_scaled_jacobian),
         seconds: r.seconds_wall.max(r.seconds_total),
@@ -601,7 +682,7 @@ pub fn fem_fixed(
         fallback: joined(&mesher.fallbacks),
         curved_elements_straightened: r.curved_elements_straightened,
     };
-    let mut outcome = setup.outcome(force_n, config, summary, meshed.mesh, solution);
+    let mut outcome = setup.outcome(force_n, config, summary, mesh, solution);
     outcome.buckling_run = buckling_run;
     Ok(outcome)
 }
@@ -667,8 +748,8 @@ pub fn fem_adaptive(
     let summary = MeshSummary {
         source: format!("{}, adaptive", setup.source()),
         size_mm: None,
-        elements: r.elements,
-        nodes: r.nodes,
+        elements: out.mesh.n_elements(),
+        nodes: out.mesh.n_nodes(),
         min_sicn: Some(r.min_sicn),
         min_scaled_jacobian: Some(r.min_scaled_jacobian),
         seconds: out.mesh_s,
@@ -879,8 +960,11 @@ pub fn fem_refinement(
     work_dir: &Path,
     sizes_mm: &[f64],
 ) -> Result<RefinementStudy> {
-    // meshed in the rod frame, mm, as stage 3 meshes (any units and pose)
-    let setup = Setup::new(design, config, true, false)?;
+    // meshed in the rod frame, mm, as stage 3 meshes (any units and pose); the whole rod, whose
+    // uniform meshes the study compares
+    let mut setup = Setup::new(design, config, true, false)?;
+    setup.half = None;
+    setup.rod.mirror_plane_z_m = None;
     for &size in sizes_mm {
         setup.check_uniform_size(design, size, "`--refine` size")?;
     }
