@@ -95,14 +95,18 @@ mod tests {
         let mut bad = sizes.clone();
         bad[0] = 0.0;
         assert!(write_size_field(&path, &mesh, &bad, 1e3, None).is_err());
-        // above z = 0.5 mm: the elements of the upper half of the cube's six only
-        write_size_field(&path, &mesh, &sizes, 1e3, Some(0.5e-3)).unwrap();
-        let above = mesh
-            .elements()
-            .iter()
-            .filter(|el| el[..4].iter().any(|&n| mesh.nodes()[n][2] > 0.5e-3))
-            .count();
-        assert!(above > 0 && above < mesh.n_elements());
-        assert_eq!(std::fs::read(&path).unwrap().len(), 16 * 8 * above);
+        // two layers of cubes: above z = 0.5 mm, the upper layer's six elements only
+        let two = box_tet10(0.002, 0.001, 0.001, 1, 1, 2).unwrap();
+        let sizes = vec![1e-3; two.n_nodes()];
+        write_size_field(&path, &two, &sizes, 1e3, Some(0.5e-3)).unwrap();
+        let v: Vec<f64> = std::fs::read(&path)
+            .unwrap()
+            .chunks_exact(8)
+            .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+            .collect();
+        assert_eq!((two.n_elements(), v.len()), (12, 16 * 6));
+        for rec in v.chunks_exact(16) {
+            assert!(rec[8..12].iter().all(|z| *z >= 0.5));
+        }
     }
 }
