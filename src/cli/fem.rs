@@ -244,6 +244,12 @@ fn print_result(d: &DesignFem) {
         f.loaded_bore.radius_mm,
         f.fixed_bore.radius_mm
     );
+    if let Some(h) = &f.half_model {
+        println!(
+            "half model: the rod is symmetric about z = {:.3} mm; its half ({} tet10, {} nodes) was solved with u_z = 0 on the plane ({} nodes) and mirrored: the DOFs are the half's, the elements, nodes and fields the whole's",
+            h.plane_z_mm, h.elements, h.nodes, h.plane_nodes
+        );
+    }
     if let Some(fallback) = &d.mesh.fallback {
         println!(
             "mesh fallback: {fallback} (gmsh could not mesh the reparametrised surface as classified)"

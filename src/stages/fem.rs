@@ -598,7 +598,6 @@ pub const HALF_MODEL_VAR: &str = "RODSTUDY_HALF_MODEL";
 /// is meshed, as without symmetry).
 fn half_surface(surface: &RodFrameSurface, symmetry: Symmetry) -> Option<HalfSurface> {
     use crate::geometry::primitives::{binary_stl, to_soup};
-    use sha2::Digest;
     let symmetry = match std::env::var(HALF_MODEL_VAR).as_deref() {
         Ok("1") => Symmetry::Auto,
         Ok("0") => Symmetry::Off,
@@ -628,10 +627,7 @@ fn half_surface(surface: &RodFrameSurface, symmetry: Symmetry) -> Option<HalfSur
     }
     let stl_bytes = binary_stl(&to_soup(&half.mesh));
     Some(HalfSurface {
-        digest: sha2::Sha256::digest(&stl_bytes)
-            .iter()
-            .map(|b| format!("{b:02x}"))
-            .collect(),
+        digest: super::rod_surface::sha256_hex(&stl_bytes),
         stl_bytes,
         plane_z_mm: fit.z,
     })

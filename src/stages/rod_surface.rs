@@ -64,7 +64,6 @@ impl RodFrameSurface {
 /// `simplified` (a given mesh needs the surface only for its sharp re-entrant edges: the export as
 /// it is, without the simplification's cost).
 pub fn rod_frame_surface(d: &LoadedDesign, simplified: bool) -> RodFrameSurface {
-    use sha2::Digest;
     let f = &d.frame;
     let mut mesh = d.mesh.clone();
     for v in &mut mesh.vertices {
@@ -88,14 +87,20 @@ pub fn rod_frame_surface(d: &LoadedDesign, simplified: bool) -> RodFrameSurface 
         vertices: mesh.vertices.iter().map(|v| [v.x, v.y, v.z]).collect(),
         triangles: mesh.triangles.clone(),
         centre_distance_mm: f.centre_distance * 1e3,
-        digest: sha2::Sha256::digest(&bytes)
-            .iter()
-            .map(|b| format!("{b:02x}"))
-            .collect(),
+        digest: sha256_hex(&bytes),
         stl_bytes: bytes,
         frame: *f,
         to_metres: d.settings.units.to_metres(),
         triangles_export: before,
         simplify_max_error_mm: max_error,
     }
+}
+
+/// SHA-256 of `bytes`, lower-case hex (the key of gmsh's classified-surface cache).
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    use sha2::Digest;
+    sha2::Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
 }
