@@ -141,7 +141,23 @@ impl Symmetry {
     fn is_off(&self) -> bool {
         *self == Symmetry::Off
     }
+
+    /// `self`, or what [`HALF_MODEL_VAR`] says: `1` as `"auto"`, `0` as `"off"`.
+    pub fn overridden(self) -> Result<Self> {
+        match std::env::var(HALF_MODEL_VAR).as_deref() {
+            Ok("1") => Ok(Symmetry::Auto),
+            Ok("0") => Ok(Symmetry::Off),
+            Ok(other) => anyhow::bail!(
+                "{HALF_MODEL_VAR} must be 1 (the half model of a symmetric rod, as [fem] symmetry = \"auto\") or 0 (the whole rod), got {other:?}"
+            ),
+            Err(_) => Ok(self),
+        }
+    }
 }
+
+/// Environment variable overriding `[fem] symmetry` (for comparing the two routes, e.g. in
+/// `bench fem --adaptive`): `1` as `"auto"`, `0` as `"off"`.
+pub const HALF_MODEL_VAR: &str = "RODSTUDY_HALF_MODEL";
 
 impl FemConfig {
     /// The default of `step_min_size_mm`.
@@ -478,13 +494,17 @@ impl StudyConfig {
         Ok(config)
     }
 
-    /// `path` if given, else `rodstudy.toml` in the current folder if it exists, else defaults.
+    /// `path` if given, else `rodstudy.toml` in the current folder if it exists, else defaults;
+    /// `[fem] symmetry` as [`HALF_MODEL_VAR`] overrides it (so that what was run is what the
+    /// configuration records, and what keys the study's cache).
     pub fn load(path: Option<&Path>) -> Result<Self> {
-        match path {
-            Some(p) => Self::read(p),
-            None if Path::new("rodstudy.toml").is_file() => Self::read(Path::new("rodstudy.toml")),
-            None => Ok(Self::default()),
-        }
+        let mut config = match path {
+            Some(p) => Self::read(p)?,
+            None if Path::new("rodstudy.toml").is_file() => Self::read(Path::new("rodstudy.toml"))?,
+            None => Self::default(),
+        };
+        config.fem.symmetry = config.fem.symmetry.overridden()?;
+        Ok(config)
     }
 
     fn check(&self) -> Result<()> {

@@ -26,7 +26,7 @@ pub struct MirrorFit {
     pub z: f64,
     /// The largest distance of a vertex's mirror image from the surface.
     pub max_deviation: f64,
-    /// Where the largest deviation is (the vertex, not its image).
+    /// Where the largest deviation is (the vertex or triangle centroid, not its image).
     pub worst_vertex: [f64; 3],
 }
 
@@ -51,8 +51,18 @@ pub fn mirror_fit_z(mesh: &IndexedMesh) -> Option<MirrorFit> {
         .map(|v| PVec::new(v.x, v.y, v.z))
         .collect();
     let surface = TriMesh::new(vertices, mesh.triangles.clone()).ok()?;
-    let (max_deviation, worst) = mesh
+    // the vertices and the triangles' centroids: a one-sided feature whose vertices all mirror
+    // onto faces (a slanted hole with vertices at its rims only) shows at its walls' centroids
+    let points: Vec<Vector3<f64>> = mesh
         .vertices
+        .iter()
+        .copied()
+        .chain((0..mesh.triangles.len()).map(|t| {
+            let [a, b, c] = mesh.corners(t);
+            (a + b + c) / 3.0
+        }))
+        .collect();
+    let (max_deviation, worst) = points
         .par_iter()
         .map(|v| {
             let image = PVec::new(v.x, v.y, 2.0 * z - v.z);
@@ -83,6 +93,42 @@ mod tests {
         let t = hollow_cylinder(2.0, 1.0, 4.0, 48);
         let f = mirror_fit_z(&t).unwrap();
         assert!(f.max_deviation < 1e-12 && f.is_symmetric(1e-9), "{f:?}");
+    }
+
+    /// A block with a hole through it, slanted: its top rim moved along x by the hole's width, so
+    /// that every rim vertex mirrors onto a face (or the hole's rim line) and only the walls'
+    /// centroids show the slant.
+    #[test]
+    fn a_slanted_hole_is_seen_at_its_walls() {
+        let mut m = voxel_solid(
+            [3, 3, 1],
+            Vector3::new(1.0, 1.0, 2.0),
+            Vector3::zeros(),
+            |i, j, _| !(i == 1 && j == 1),
+        );
+        for v in &mut m.vertices {
+            if v.z == 2.0 && (1.0..=2.0).contains(&v.x) && (1.0..=2.0).contains(&v.y) {
+                v.x += 0.5;
+            }
+        }
+        let vertices_only = m
+            .vertices
+            .iter()
+            .map(|v| {
+                let tri = TriMesh::new(
+                    m.vertices
+                        .iter()
+                        .map(|p| PVec::new(p.x, p.y, p.z))
+                        .collect(),
+                    m.triangles.clone(),
+                )
+                .unwrap();
+                tri.distance_to_local_point(PVec::new(v.x, v.y, 2.0 - v.z), false)
+            })
+            .fold(0.0f64, f64::max);
+        assert!(vertices_only < 1e-12, "{vertices_only}");
+        let f = mirror_fit_z(&m).unwrap();
+        assert!(f.max_deviation > 0.1 && !f.is_symmetric(0.05), "{f:?}");
     }
 
     /// A block with a pocket in its top face only: the pocket's floor, mirrored, lies inside the

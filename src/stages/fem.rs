@@ -588,21 +588,12 @@ struct HalfSurface {
 /// the surface is halved.
 pub const MIRROR_TOLERANCE_MM: f64 = 0.05;
 
-/// Environment variable overriding `[fem] symmetry` (for comparing the two routes, e.g. in
-/// `bench fem --adaptive`): `1` as `"auto"`, `0` as `"off"`.
-pub const HALF_MODEL_VAR: &str = "RODSTUDY_HALF_MODEL";
-
 /// The half of `surface` (rod frame, mm) when the rod is mirror-symmetric about the plane halving
 /// its thickness ([`crate::geometry::mirror_symmetry`]) and `symmetry` allows; `None` otherwise,
 /// or when the halved surface is not a valid closed solid of half the volume (then the whole rod
 /// is meshed, as without symmetry).
 fn half_surface(surface: &RodFrameSurface, symmetry: Symmetry) -> Option<HalfSurface> {
     use crate::geometry::primitives::{binary_stl, to_soup};
-    let symmetry = match std::env::var(HALF_MODEL_VAR).as_deref() {
-        Ok("1") => Symmetry::Auto,
-        Ok("0") => Symmetry::Off,
-        _ => symmetry,
-    };
     if symmetry == Symmetry::Off {
         return None;
     }
