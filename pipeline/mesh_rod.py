@@ -279,6 +279,84 @@ def tet10_qualities() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return tags10, min_sj, min_sicn
 
 
+
+def cap_open_cut(plane_tol_rel: float = 1e-6) -> list[int]:
+    """The half model's cap: the Rust side hands over the half of a mirror-symmetric rod open at
+    its cut (z = c), and the classification leaves the cut as curves that bound one surface each.
+    They are chained into loops (outline and holes, nested by their bounding boxes) and each
+    outline closed with a plane surface on the very curves (`geo.addCurveLoop` /
+    `addPlaneSurface`), so that gmsh meshes the cap as one plane and no parametrisation cut of
+    the classification crosses it or meets the cut's edge. Returns the plane surfaces' tags, none
+    for a closed surface (every whole rod). An open surface whose open edges are not in one plane
+    z = const, or do not form simple loops, is refused."""
+    import gmsh
+
+    open_curves = [c for _, c in gmsh.model.getEntities(1)
+                   if len(gmsh.model.getAdjacencies(1, c)[0]) == 1]
+    if not open_curves:
+        return []
+    boxes = {c: gmsh.model.getBoundingBox(1, c) for c in open_curves}
+    zs = [v for b in boxes.values() for v in (b[2], b[5])]
+    # the curves' boxes come from their reparametrisation (seen: 3e-6 mm off the cut's plane on
+    # a rod of 200 mm)
+    whole = gmsh.model.getBoundingBox(-1, -1)
+    extent = max(whole[3] - whole[0], whole[4] - whole[1], whole[5] - whole[2])
+    if max(zs) - min(zs) > plane_tol_rel * extent:
+        raise RuntimeError(f"the surface is open, and its open edges do not lie in one plane z = const "
+                           f"(z from {min(zs)} to {max(zs)} mm)")
+    ends = {}
+    for c in open_curves:
+        b = [t for _, t in gmsh.model.getBoundary([(1, c)], combined=False, oriented=False)]
+        ends[c] = (b[0], b[-1]) if b else (None, None)
+    by_point: dict = {}
+    for c, (a, b) in ends.items():
+        if a is not None and a != b:
+            by_point.setdefault(a, []).append(c)
+            by_point.setdefault(b, []).append(c)
+    left = set(open_curves)
+    loops = []
+    for c0 in open_curves:
+        if c0 not in left:
+            continue
+        left.discard(c0)
+        a, b = ends[c0]
+        loop = [c0]
+        if a is not None and a != b:
+            start, at = a, b
+            while at != start:
+                nxt = [c for c in by_point.get(at, []) if c in left]
+                if len(nxt) != 1:
+                    raise RuntimeError(f"the open edges do not form simple loops at point {at}")
+                c = nxt[0]
+                left.discard(c)
+                if ends[c][0] == at:
+                    loop.append(c)
+                    at = ends[c][1]
+                else:
+                    loop.append(-c)
+                    at = ends[c][0]
+        loops.append(loop)
+
+    def box(loop):
+        bs = [boxes[abs(c)] for c in loop]
+        return (min(b[0] for b in bs), min(b[1] for b in bs), max(b[3] for b in bs), max(b[4] for b in bs))
+
+    lb = [box(l) for l in loops]
+
+    def inside(i, j):  # loop i's box strictly inside loop j's
+        return i != j and lb[j][0] <= lb[i][0] and lb[j][1] <= lb[i][1] and lb[i][2] <= lb[j][2] and lb[i][3] <= lb[j][3]
+
+    depth = [sum(inside(i, j) for j in range(len(loops))) for i in range(len(loops))]
+    tags = [gmsh.model.geo.addCurveLoop(l) for l in loops]
+    caps = []
+    for i in range(len(loops)):
+        if depth[i] % 2:
+            continue
+        holes = [tags[k] for k in range(len(loops)) if depth[k] == depth[i] + 1 and inside(k, i)]
+        caps.append(gmsh.model.geo.addPlaneSurface([tags[i]] + holes))
+    return caps
+
+
 def build_volume(stl: pathlib.Path, angle_deg: float, curve_angle_deg: float,
                  geometry_in: pathlib.Path | None = None, geometry_out: pathlib.Path | None = None) -> int:
     """The model "rod": the STL's surface classified into patches (or the classification of
@@ -301,7 +379,7 @@ def build_volume(stl: pathlib.Path, angle_deg: float, curve_angle_deg: float,
             gmsh.clear()
             gmsh.merge(str(geometry_out))
     gmsh.model.mesh.createGeometry()
-    surfaces = [tag for _, tag in gmsh.model.getEntities(2)]
+    surfaces = [tag for _, tag in gmsh.model.getEntities(2)] + cap_open_cut()
     loop = gmsh.model.geo.addSurfaceLoop(surfaces)
     gmsh.model.geo.addVolume([loop])
     gmsh.model.geo.synchronize()
@@ -653,6 +731,17 @@ def start_size(tag: int, size_mm: float, field_data, centroids: dict) -> float:
     return min(size_mm, field_size_near(field_data, centroids[tag]))
 
 
+def has_open_edges() -> bool:
+    """Whether the triangles of the model (a merged STL) have an edge used by one triangle only."""
+    import gmsh
+
+    _, _, nodes = gmsh.model.mesh.getElements(2)
+    tri = np.concatenate([n for n in nodes]).reshape(-1, 3) if nodes else np.zeros((0, 3), dtype=np.uint64)
+    edges = np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1)
+    _, counts = np.unique(edges, axis=0, return_counts=True)
+    return bool((counts == 1).any())
+
+
 def gmsh_surface_kept(stl: pathlib.Path, size_mm: float, msh_out: pathlib.Path,
                       size_field: pathlib.Path | None) -> dict:
     """The fallback "STL surface kept" (see FALLBACKS)."""
@@ -667,6 +756,10 @@ def gmsh_surface_kept(stl: pathlib.Path, size_mm: float, msh_out: pathlib.Path,
         gmsh.model.add("rod")
         gmsh.merge(str(stl))
         surfaces = [tag for _, tag in gmsh.model.getEntities(2)]
+        if has_open_edges():
+            # the half model's open cut: its boundary curves, then the cap on them
+            gmsh.model.mesh.createTopology()
+            surfaces = [tag for _, tag in gmsh.model.getEntities(2)] + cap_open_cut()
         loop = gmsh.model.geo.addSurfaceLoop(surfaces)
         gmsh.model.geo.addVolume([loop])
         gmsh.model.geo.synchronize()
@@ -977,7 +1070,20 @@ def served_mesh(request: dict, stl: pathlib.Path, geometry: pathlib.Path, state:
         set_options(size, False, size_field is not None, False)
         patches = build_volume(stl, angle, curve_angle, geometry if reused else None, geo_out)
     t1 = time.perf_counter()
-    info = mesh_volume(msh, size_field, False, binary=True)
+    try:
+        info = mesh_volume(msh, size_field, False, binary=True)
+    except Exception as e:  # noqa: BLE001 - as `mesh`'s attempt: HXT's failures only
+        if "HXT" not in str(e):
+            raise
+        # as `mesh` does it (`run_attempt`): Delaunay with Netgen's optimisation on a model
+        # rebuilt from the classification just made or cached, in this session
+        log(f"  HXT failed ({e}); Delaunay instead")
+        gmsh.clear()
+        set_options(size, False, size_field is not None, True)
+        classified = geometry if reused else geo_out
+        patches = build_volume(stl, angle, curve_angle, classified, None)
+        t1 = time.perf_counter()
+        info = mesh_volume(msh, size_field, True, binary=True)
     if geo_out is not None and geo_out.is_file():
         geo_out.replace(geometry)
         meta.write_text(json.dumps({"classify_angle_deg": angle, "curve_angle_deg": curve_angle}))

@@ -93,3 +93,77 @@ fn a_symmetric_rod_solved_as_its_half_agrees_with_the_whole() {
     let vtu = std::fs::read_to_string(dir.path().join("auto/fem_fy.vtu")).unwrap();
     assert!(vtu.contains(&format!("NumberOfPoints=\"{}\"", nodes as usize)));
 }
+
+/// The half's cap is gmsh's: the Rust side hands over the half open at the cut, and the mesher
+/// closes it with one plane surface on the cut's curves (`mesh_rod.py`, `cap_open_cut`). Checked
+/// on the mesh gmsh made: the boundary faces in the plane z = c cover the section, whose area the
+/// open surface gives independently (a closed surface has ∮ n_z dA = 0, so the cap's area is the
+/// z-projected area of the rest), and every one of them points out of the half.
+#[test]
+fn the_half_is_capped_by_gmsh_on_the_cut() {
+    use std::collections::HashMap;
+    let dir = tempfile::tempdir().unwrap();
+    let half = fem_json(dir.path(), "auto");
+    let c = half["fem"]["half_model"]["plane_z_mm"].as_f64().unwrap();
+    // the open surface gmsh was given
+    let (soup, _) =
+        rodstudy::geometry::stl_file::read_stl_file(&dir.path().join("auto/mesh/rod_frame.stl"))
+            .unwrap();
+    let projected: f64 = soup
+        .iter()
+        .map(|t| {
+            let p = t.map(|v| v.map(f64::from));
+            0.5 * ((p[1][0] - p[0][0]) * (p[2][1] - p[0][1])
+                - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]))
+        })
+        .sum();
+    let on_plane = soup
+        .iter()
+        .filter(|t| t.iter().all(|v| f64::from(v[2]) == c))
+        .count();
+    assert_eq!(on_plane, 0, "the STL handed to gmsh is open at the cut");
+    // the mesh gmsh made of the half
+    let mesh = rodstudy::mesher::read_volume_mesh_native(
+        &dir.path().join("auto/mesh/fixed/rod.msh"),
+        "mm",
+    )
+    .unwrap();
+    let mut faces: HashMap<[usize; 3], ([usize; 3], usize)> = HashMap::new();
+    for el in mesh.elements() {
+        for f in [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]] {
+            let tri = f.map(|k| el[k]);
+            let mut key = tri;
+            key.sort_unstable();
+            faces.entry(key).or_insert((tri, 0)).1 += 1;
+        }
+    }
+    let nodes = mesh.nodes();
+    let (mut area, mut facing_down) = (0.0, 0usize);
+    let mut cap_faces = 0usize;
+    for (tri, count) in faces.values() {
+        if *count != 1 || !tri.iter().all(|&n| (nodes[n][2] * 1e3 - c).abs() < 1e-9) {
+            continue;
+        }
+        cap_faces += 1;
+        let p = tri.map(|n| nodes[n].map(|x| x * 1e3));
+        let nz =
+            (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]);
+        area += 0.5 * nz.abs();
+        facing_down += usize::from(nz < 0.0);
+    }
+    eprintln!(
+        "cap: {cap_faces} faces, {area:.3} mm² of a section of {projected:.3} mm² (from the open surface)"
+    );
+    assert!(cap_faces > 100);
+    assert_eq!(
+        facing_down, cap_faces,
+        "every cap face points out of the half (−z)"
+    );
+    // within the chords of the 6 mm elements along the section's round edges (a chord s across
+    // a radius r cuts off about s²/(6 r²) of a circle's area: ~1 % of a bore's, bores being holes
+    // in the section; measured 0.13 %)
+    assert!(
+        (area / projected - 1.0).abs() < 5e-3,
+        "cap {area} mm² against the section {projected} mm²"
+    );
+}

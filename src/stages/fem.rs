@@ -572,8 +572,10 @@ impl Setup {
     }
 }
 
-/// The half model's surface: the rod-frame surface's half z ≥ c, capped in the plane, as the
-/// binary STL gmsh meshes.
+/// The half model's surface: the rod-frame surface's half z ≥ c as the binary STL gmsh meshes,
+/// open at the cut (gmsh closes it with a plane surface on the cut's classified curves,
+/// `mesh_rod.py`'s `cap_open_cut`; the cap of [`crate::geometry::half_solid::half_above`] is what
+/// shows the half to be a closed solid of half the volume).
 struct HalfSurface {
     stl_bytes: Vec<u8>,
     /// SHA-256 of the STL bytes (keys the classified-surface cache).
@@ -616,7 +618,20 @@ fn half_surface(surface: &RodFrameSurface, symmetry: Symmetry) -> Option<HalfSur
     if !half.warnings.is_empty() || (ratio - 0.5).abs() > 1e-3 {
         return None;
     }
-    let stl_bytes = binary_stl(&to_soup(&half.mesh));
+    // gmsh gets the half open at the cut and builds the cap itself, as one plane surface on the
+    // cut's classified curves (`mesh_rod.py`, `cap_open_cut`): the cap's triangles would be
+    // classified into patches whose cuts meet the cut's edge, where the peaks of a bending rod lie
+    let open = crate::geometry::IndexedMesh {
+        vertices: half.mesh.vertices.clone(),
+        triangles: half
+            .mesh
+            .triangles
+            .iter()
+            .filter(|t| t.iter().any(|&i| half.mesh.vertices[i as usize].z > fit.z))
+            .copied()
+            .collect(),
+    };
+    let stl_bytes = binary_stl(&to_soup(&open));
     Some(HalfSurface {
         digest: super::rod_surface::sha256_hex(&stl_bytes),
         stl_bytes,
