@@ -337,17 +337,19 @@ def cap_open_cut(plane_tol_rel: float = 1e-6) -> list[int]:
                     at = ends[c][0]
         loops.append(loop)
 
-    def box(loop):
+    def box(loop):  # (x_min, y_min, x_max, y_max) of a loop
         bs = [boxes[abs(c)] for c in loop]
         return (min(b[0] for b in bs), min(b[1] for b in bs), max(b[3] for b in bs), max(b[4] for b in bs))
 
-    lb = [box(l) for l in loops]
+    lb = [box(loop) for loop in loops]
 
-    def inside(i, j):  # loop i's box strictly inside loop j's
-        return i != j and lb[j][0] <= lb[i][0] and lb[j][1] <= lb[i][1] and lb[i][2] <= lb[j][2] and lb[i][3] <= lb[j][3]
+    def inside(i, j):  # loop i's box within loop j's
+        return (i != j and lb[j][0] <= lb[i][0] and lb[j][1] <= lb[i][1]
+                and lb[i][2] <= lb[j][2] and lb[i][3] <= lb[j][3])
 
+    # an outline has an even number of loops around it, a hole an odd one
     depth = [sum(inside(i, j) for j in range(len(loops))) for i in range(len(loops))]
-    tags = [gmsh.model.geo.addCurveLoop(l) for l in loops]
+    tags = [gmsh.model.geo.addCurveLoop(loop) for loop in loops]
     caps = []
     for i in range(len(loops)):
         if depth[i] % 2:
@@ -360,8 +362,8 @@ def cap_open_cut(plane_tol_rel: float = 1e-6) -> list[int]:
 def build_volume(stl: pathlib.Path, angle_deg: float, curve_angle_deg: float,
                  geometry_in: pathlib.Path | None = None, geometry_out: pathlib.Path | None = None) -> int:
     """The model "rod": the STL's surface classified into patches (or the classification of
-    `geometry_in`), reparametrised (`createGeometry`), closed into one volume. Returns the number of
-    surface patches."""
+    `geometry_in`), reparametrised (`createGeometry`), closed into one volume (a half model's open
+    cut capped first, `cap_open_cut`). Returns the number of surface patches, caps included."""
     import gmsh
 
     gmsh.model.add("rod")
