@@ -63,6 +63,7 @@ Usage
   python pipeline/make_designs.py --check       regenerate in a temporary folder and compare
   python pipeline/make_designs.py --only 3      one design only (combines with --check)
   python pipeline/make_designs.py --selftest    verify the mass-property integration and STL writer
+  python pipeline/make_designs.py --step DIR    the calibrated designs' exact B-reps as DIR/designN.step
 """
 
 from __future__ import annotations
@@ -776,6 +777,23 @@ def run(numbers, out_dir: pathlib.Path) -> list:
     return results
 
 
+def write_steps(numbers, step_dir: pathlib.Path) -> int:
+    """The exact B-rep of each calibrated design (the parameters its STL is tessellated from) as
+    STEP_DIR/designN.step: the reference geometry of the STL route's error estimates (stage 3 on
+    a STEP meshes the exact surfaces with curved tet10 and has no facet floor; docs/fem.md)."""
+    gmsh_start()
+    step_dir.mkdir(parents=True, exist_ok=True)
+    for n in numbers:
+        d = DESIGNS[n]
+        res = generate(d)
+        build_rod(d, res["params"])
+        gmsh.model.occ.synchronize()
+        path = step_dir / f"design{n}.step"
+        gmsh.write(str(path))
+        print(f"  design {n}: wrote {path} ({fmt_params(d, res['params'])})", flush=True)
+    return 0
+
+
 def check(numbers, committed: pathlib.Path) -> int:
     """Regenerate into a temporary folder and compare with the committed files."""
     with tempfile.TemporaryDirectory(prefix="rodstudy-designs-") as tmp:
@@ -956,6 +974,8 @@ def main(argv=None) -> int:
                     help="build only this design (repeatable)")
     ap.add_argument("--out", type=pathlib.Path, default=DESIGNS_DIR, help="output folder (default designs/)")
     ap.add_argument("--selftest", action="store_true", help="verify the integration and the STL writer")
+    ap.add_argument("--step", type=pathlib.Path, metavar="DIR",
+                    help="write the calibrated designs' exact B-reps as DIR/designN.step (no STL)")
     args = ap.parse_args(argv)
     numbers = sorted(set(args.only)) if args.only else sorted(DESIGNS)
     t0 = time.perf_counter()
@@ -964,6 +984,8 @@ def main(argv=None) -> int:
             return selftest()
         if args.check:
             return check(numbers, args.out)
+        if args.step is not None:
+            return write_steps(numbers, args.step)
         results = run(numbers, args.out)
         ok = report(results)
         print(f"\nwrote {len(results)} design(s) to {args.out} in {time.perf_counter() - t0:.1f} s")

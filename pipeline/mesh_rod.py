@@ -203,10 +203,11 @@ def gmsh_options(size_mm: float, curved: bool, size_field: bool = False) -> dict
         opts["Mesh.MeshSizeExtendFromBoundary"] = 0
         # the curves' 1D mesh integrates 1/size along each curve to this relative precision; the
         # default 1e-9 made gmsh evaluate the piecewise-linear field so often that the 1D mesh
-        # took 0.8 s of a 1.5 s mesh (design 1); at 1e-6, 0.23 s, the same number of nodes to 0.2 %.
-        # (1e-3 is 0.2 s faster again on design 1's second mesh, but its slightly different meshes
-        # took designs 2 and 4 through five meshes instead of four and three: not adopted)
-        opts["Mesh.LcIntegrationPrecision"] = 1e-6
+        # took 0.8 s of a 1.5 s mesh (design 1); 1e-6 took 0.23 s on the whole rod, but 0.5-1.1 s
+        # of a half model's later mesh (its cut's long curves); 1e-3 takes 0.15-0.36 s there
+        # (issue 21, session 29; the node spacing along a curve moves by far less than the
+        # element sizes the loop asks for)
+        opts["Mesh.LcIntegrationPrecision"] = 1e-3
     else:
         opts["Mesh.LcIntegrationPrecision"] = 1e-9  # gmsh's default (a session's later mesh resets it)
     return opts

@@ -117,12 +117,12 @@ pub struct FemConfig {
     /// written into `results.json`.
     #[serde(skip_serializing_if = "BoreLoad::is_uniform")]
     pub bore_load: BoreLoad,
-    /// `"off"` (default): the whole rod; `"auto"`: an STL rod symmetric about its mid-plane
-    /// across the pin axis (within [`crate::stages::fem::MIRROR_TOLERANCE_MM`]) is meshed and
-    /// solved as its half with u_z = 0 on the plane, then mirrored (the same answer on the same
-    /// mesh, from half the DOFs; the adaptive loop's meshes differ, docs/fem.md). The default is
-    /// not written into `results.json`.
-    #[serde(skip_serializing_if = "Symmetry::is_off")]
+    /// `"auto"` (default): an STL rod symmetric about its mid-plane across the pin axis (within
+    /// [`crate::stages::fem::MIRROR_TOLERANCE_MM`]) is meshed and solved as its half with
+    /// u_z = 0 on the plane, then mirrored (the same answer on the same mesh, from half the
+    /// DOFs; docs/fem.md); `"off"`: always the whole rod (the route before issue 21's session
+    /// 29). The default is not written into `results.json`.
+    #[serde(skip_serializing_if = "Symmetry::is_default")]
     pub symmetry: Symmetry,
 }
 
@@ -131,15 +131,15 @@ pub struct FemConfig {
 #[serde(rename_all = "snake_case")]
 pub enum Symmetry {
     /// Always the whole rod.
-    #[default]
     Off,
     /// The half model where the surface is symmetric.
+    #[default]
     Auto,
 }
 
 impl Symmetry {
-    fn is_off(&self) -> bool {
-        *self == Symmetry::Off
+    fn is_default(&self) -> bool {
+        *self == Symmetry::default()
     }
 
     /// `self`, or what [`HALF_MODEL_VAR`] says: `1` as `"auto"`, `0` as `"off"`.
@@ -184,7 +184,7 @@ impl Default for FemConfig {
             youngs_modulus_pa: 210e9,
             poisson_ratio: 0.3,
             bore_load: BoreLoad::Uniform,
-            symmetry: Symmetry::Off,
+            symmetry: Symmetry::Auto,
         }
     }
 }

@@ -381,3 +381,106 @@ fn the_geometry_error_of_a_coarse_cad_export_is_estimated_honestly() {
         }
     }
 }
+
+/// The exact-geometry references of the committed designs (`tests/data/design_references.json`).
+fn design_references() -> serde_json::Value {
+    serde_json::from_str(
+        &std::fs::read_to_string(root().join("tests/data/design_references.json")).unwrap(),
+    )
+    .unwrap()
+}
+
+/// True error of `peak` against a design's reference of `case`, with the reference's own
+/// estimated uncertainty (relative): (true error, reference, its uncertainty).
+fn against_reference(refs: &serde_json::Value, id: &str, case: &str, peak: f64) -> (f64, f64, f64) {
+    let r = &refs["designs"][id][case];
+    let reference = r["peak_mpa"].as_f64().unwrap();
+    let uncertainty = r["estimated_error_rel"].as_f64().unwrap();
+    ((peak - reference).abs() / reference, reference, uncertainty)
+}
+
+/// Issue 21: the judged F_y peak of each committed design, as `cargo run --release -- study`
+/// wrote it into `reports/results.json` (which CI regenerates and compares byte for byte), is
+/// honest against the design's exact geometry: curved tet10 on the calibrated B-rep refined to
+/// 1 % (`make_designs.py --step`, `tests/data/design_references.json`). The true error is within
+/// twice the reported bar (with the reference's own uncertainty) and within the 3 % target.
+#[test]
+fn the_committed_reports_agree_with_the_exact_geometry() {
+    let refs = design_references();
+    let results: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(root().join("reports/results.json")).unwrap(),
+    )
+    .unwrap();
+    let designs = results["designs"].as_array().unwrap();
+    assert_eq!(designs.len(), 5);
+    for d in designs {
+        let id = d["mass"]["id"].as_str().unwrap();
+        let fy = &d["fem"]["fem"]["fy"];
+        let peak = fy["max_von_mises_away_from_fixed_mpa"].as_f64().unwrap();
+        let est = fy["estimated_error_rel"].as_f64().unwrap();
+        let (true_error, reference, unc) = against_reference(&refs, id, "fy", peak);
+        eprintln!(
+            "{id}: F_y {peak:.2} ± {:.2} % against {reference:.2} ± {:.2} %: true {:.2} %, true / estimated {:.2}",
+            100.0 * est,
+            100.0 * unc,
+            100.0 * true_error,
+            true_error / est
+        );
+        assert!(true_error <= 2.0 * est + unc, "{id}: {true_error} vs {est}");
+        assert!(true_error <= 0.03 + unc, "{id}: {true_error}");
+    }
+}
+
+/// Issue 21 item 3: designs 4 and 5 through the adaptive loop as the study runs it (the half
+/// model, the grid convergence index on three meshes), against their exact geometry. Design 4's
+/// F_y peak sits on a slot-end R4 fillet faceted at 10° whose facet floor (0.7 mm) the loop
+/// reaches on its third mesh; design 5's had the largest true / estimated of the five. Both
+/// converge to the 3 % target, within twice their bars of the reference.
+#[test]
+fn designs_4_and_5_converge_honestly_against_their_exact_geometry() {
+    let refs = design_references();
+    let config = StudyConfig::default();
+    let dir = tempfile::tempdir().unwrap();
+    for id in ["design4", "design5"] {
+        let force = refs["designs"][id]["force_n"].as_f64().unwrap();
+        let stl = root().join(format!("designs/{id}.stl"));
+        let r = adaptive_record(&stl, force, &config, &dir.path().join(id));
+        let adaptive = r.mesh.adaptive.as_ref().expect("an adaptive record");
+        eprintln!(
+            "{id}: {:?}, meshes (DOFs, F_y peak MPa, size at it mm): {:?}",
+            adaptive.stop,
+            r.fem
+                .fy
+                .adaptive
+                .iter()
+                .map(|s| (s.dofs, s.peak_mpa, s.size_at_peak_mm))
+                .collect::<Vec<_>>()
+        );
+        assert!(r.fem.half_model.is_some(), "{id}: meshed as its half");
+        assert_eq!(
+            adaptive.stop,
+            rodstudy::fem::adapt::StopReason::Converged,
+            "{id}"
+        );
+        for (case, got) in [("fx", &r.fem.fx), ("fy", &r.fem.fy)] {
+            let peak = got.max_von_mises_away_from_fixed_mpa;
+            let est = got.estimated_error_rel;
+            let (true_error, reference, unc) = against_reference(&refs, id, case, peak);
+            eprintln!(
+                "{id} {case}: {peak:.2} MPa ± {:.2} % ({:.2} % + {:.2} % geometry) against {reference:.2} ± {:.2} %: true {:.2} %, true / estimated {:.2}",
+                100.0 * est,
+                100.0 * got.estimated_discretisation_error_rel,
+                100.0 * got.estimated_geometry_error_rel.unwrap_or(0.0),
+                100.0 * unc,
+                100.0 * true_error,
+                true_error / est
+            );
+            assert!(
+                true_error <= 2.0 * est + unc,
+                "{id} {case}: true {true_error} vs estimated {est}"
+            );
+        }
+        let fy = &r.fem.fy;
+        assert!(fy.estimated_discretisation_error_rel <= 0.03, "{id}");
+    }
+}

@@ -275,6 +275,20 @@ impl SurfaceEdges {
         out
     }
 
+    /// The facet spacing at edge `e`: the mean height of its two facets over it (the distance to
+    /// the next kinks on either side), or the smaller where one is more than twice the other (a
+    /// big flat facet beside a fillet); `None` for an edge of zero length.
+    pub fn kink_spacing(&self, e: &SurfaceEdge, vertices: &[[f64; 3]]) -> Option<f64> {
+        let s = e.vertices.map(|v| vertices[v as usize]);
+        let len = (v3(s[1]) - v3(s[0])).norm();
+        if len <= 0.0 {
+            return None;
+        }
+        let [h0, h1] = e.facets.map(|f| 2.0 * self.areas[f as usize] / len);
+        let (lo, hi) = (h0.min(h1), h0.max(h1));
+        Some(if hi <= 2.0 * lo { 0.5 * (lo + hi) } else { lo })
+    }
+
     /// Edges at or above the feature angle taken for kinks of faceted small fillets.
     pub fn fillet_kinks(&self) -> usize {
         self.edges
@@ -393,13 +407,9 @@ impl FacetScale {
                 continue;
             }
             let s = e.vertices.map(|v| vertices[v as usize]);
-            let len = (v3(s[1]) - v3(s[0])).norm();
-            if len <= 0.0 {
+            let Some(h) = edges.kink_spacing(e, vertices) else {
                 continue;
-            }
-            let [h0, h1] = e.facets.map(|f| 2.0 * edges.areas[f as usize] / len);
-            let (lo, hi) = (h0.min(h1), h0.max(h1));
-            let h = if hi <= 2.0 * lo { 0.5 * (lo + hi) } else { lo };
+            };
             let id = segments.len() as u32;
             segments.push(s);
             spacing.push(h);
@@ -462,7 +472,7 @@ impl FacetScale {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// A prism over the simple counter-clockwise `outline`, from z = 0 to `height`: each side one

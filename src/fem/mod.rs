@@ -46,6 +46,7 @@ pub mod refinement;
 pub mod rod;
 pub mod rod_buckling;
 pub mod shape;
+pub mod small_fillets;
 pub mod smooth;
 pub mod solver;
 pub mod statics;

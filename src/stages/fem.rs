@@ -26,12 +26,13 @@ use super::records::{
 };
 use super::rod_surface::{RodFrameSurface, rod_frame_surface};
 use crate::config::{FemConfig, StudyConfig, Symmetry};
-use crate::fem::adapt::{AdaptOptions, adaptive_rod};
+use crate::fem::adapt::{AdaptOptions, GeometrySizes, adaptive_rod};
 use crate::fem::buckling::{BucklingMode, BucklingOptions, BucklingSolution};
 use crate::fem::facets::{FacetScale, MAX_FILLET_RADIUS_MM, SurfaceEdges};
 use crate::fem::refinement::{RefinementStudy, refinement_study};
 use crate::fem::rod::{RodSolution, rod_fields, solve_rod_on, solve_rod_static};
 use crate::fem::rod_buckling::rod_buckling;
+use crate::fem::small_fillets::{SMALL_FILLET_RADIUS_MM, SMALL_FILLET_REACH_MM, SmallFillets};
 use crate::fem::smooth::{SmoothSurface, geometry_check};
 use crate::fem::statics::FactorisedSystem;
 use crate::fem::{BoreSpec, Material, RodOptions, TetMesh};
@@ -718,6 +719,15 @@ pub fn fem_adaptive(
             facets.at(p.map(|v| v * 1e3)) * 1e-3
         }
     };
+    // a concave fillet far below the first mesh's size is refined from the second mesh on, on
+    // an STL and on a STEP's tessellation alike
+    let small_fillets = SmallFillets::from_edges(
+        setup.edges(),
+        &setup.surface.vertices,
+        SMALL_FILLET_RADIUS_MM,
+        SMALL_FILLET_REACH_MM,
+    );
+    let ceiling = |p: [f64; 3]| small_fillets.ceiling_at(p.map(|v| v * 1e3)) * 1e-3;
     let c = settings;
     let min_size_mm = if exact {
         c.step_min_size_mm
@@ -740,7 +750,10 @@ pub fn fem_adaptive(
         force_n,
         &setup.rod,
         &opts,
-        &floor,
+        &GeometrySizes {
+            floor: &floor,
+            ceiling: &ceiling,
+        },
     )
     .with_context(|| setup.context.clone())?;
     let mut out = out;
