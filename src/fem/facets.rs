@@ -34,6 +34,7 @@ use std::collections::HashMap;
 
 use nalgebra::Vector3;
 
+use super::segment_grid::SegmentGrid;
 use super::stress::point_segment_distance;
 
 /// Dihedral angle below which two facets count as coplanar (a subdivided flat face), degrees.
@@ -378,9 +379,7 @@ pub fn reentrant_edges(
 /// Facet spacing at the kinks of a triangulated surface, looked up by position.
 #[derive(Clone, Debug)]
 pub struct FacetScale {
-    cell: f64,
-    grid: HashMap<[i64; 3], Vec<u32>>,
-    segments: Vec<[[f64; 3]; 2]>,
+    kinks: SegmentGrid,
     spacing: Vec<f64>,
 }
 
@@ -398,66 +397,39 @@ impl FacetScale {
     /// the mean height of its two facets over it (the distance to the next kinks on either side),
     /// or the smaller where one is more than twice the other (a big flat facet beside a fillet).
     pub fn from_edges(edges: &SurfaceEdges, vertices: &[[f64; 3]], cell: f64) -> Self {
-        let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
-        let mut segments = Vec::new();
+        let mut kinks = SegmentGrid::new(cell);
         let mut spacing = Vec::new();
-        let key = |p: [f64; 3]| p.map(|v| (v / cell).floor() as i64);
         for e in &edges.edges {
             if !matches!(e.kind, EdgeKind::Kink | EdgeKind::Fillet) {
                 continue;
             }
-            let s = e.vertices.map(|v| vertices[v as usize]);
             let Some(h) = edges.kink_spacing(e, vertices) else {
                 continue;
             };
-            let id = segments.len() as u32;
-            segments.push(s);
+            kinks.push(e.vertices.map(|v| vertices[v as usize]));
             spacing.push(h);
-            let (kl, kh) = (
-                key(std::array::from_fn(|j| s[0][j].min(s[1][j]))),
-                key(std::array::from_fn(|j| s[0][j].max(s[1][j]))),
-            );
-            for x in kl[0]..=kh[0] {
-                for y in kl[1]..=kh[1] {
-                    for z in kl[2]..=kh[2] {
-                        grid.entry([x, y, z]).or_default().push(id);
-                    }
-                }
-            }
         }
-        FacetScale {
-            cell,
-            grid,
-            segments,
-            spacing,
-        }
+        FacetScale { kinks, spacing }
     }
 
     /// Number of kink edges.
     pub fn kink_edges(&self) -> usize {
-        self.segments.len()
+        self.kinks.len()
     }
 
     /// The spacing of the nearest kink edge within one grid cell of `p`, or 0 when there is none
     /// (flat faces and sharp features have no floor).
     pub fn at(&self, p: [f64; 3]) -> f64 {
-        let k = p.map(|v| (v / self.cell).floor() as i64);
-        let mut best = (f64::INFINITY, 0.0);
-        for dx in -1..=1 {
-            for dy in -1..=1 {
-                for dz in -1..=1 {
-                    if let Some(list) = self.grid.get(&[k[0] + dx, k[1] + dy, k[2] + dz]) {
-                        for &i in list {
-                            let d = point_segment_distance(p, self.segments[i as usize]);
-                            if d < best.0 {
-                                best = (d, self.spacing[i as usize]);
-                            }
-                        }
-                    }
+        self.kinks
+            .nearby(p)
+            .fold((f64::INFINITY, 0.0), |best, (i, d)| {
+                if d < best.0 {
+                    (d, self.spacing[i])
+                } else {
+                    best
                 }
-            }
-        }
-        if best.0 <= self.cell { best.1 } else { 0.0 }
+            })
+            .1
     }
 
     /// Median spacing over the kink edges (0 when there are none), for reports.

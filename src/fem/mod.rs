@@ -45,6 +45,7 @@ pub mod recovery;
 pub mod refinement;
 pub mod rod;
 pub mod rod_buckling;
+pub mod segment_grid;
 pub mod shape;
 pub mod small_fillets;
 pub mod smooth;

@@ -25,7 +25,7 @@
 //! surface stress better than the nodal average of σ_h (which is a weighted mean of values
 //! inside the elements and so lags behind a steep gradient).
 
-use nalgebra::{DMatrix, SMatrix, SVector};
+use nalgebra::{SMatrix, SVector};
 use rayon::prelude::*;
 
 use super::element::{ElementCoords, shape_gradients, strain};
@@ -133,45 +133,52 @@ impl PatchFit {
     }
 }
 
-/// Least-squares fit of `terms` (10 or 4) basis functions to the samples; `None` when singular.
-fn fit(
-    centre: [f64; 3],
-    scale: f64,
-    samples: &[([f64; 3], [f64; 6])],
-    terms: usize,
-) -> Option<SMatrix<f64, QUADRATIC_TERMS, 6>> {
-    let mut a = DMatrix::<f64>::zeros(terms, terms);
-    let mut rhs = DMatrix::<f64>::zeros(terms, 6);
-    for (p, s) in samples {
-        let d = std::array::from_fn(|j| (p[j] - centre[j]) / scale);
-        let b = basis(d);
-        for i in 0..terms {
-            for j in 0..terms {
-                a[(i, j)] += b[i] * b[j];
+/// The least-squares fit of the first `$t` basis functions to the samples, on stack matrices (one
+/// per corner node: no allocation); `None` when the normal matrix is near singular.
+macro_rules! fit_terms {
+    ($name:ident, $t:expr) => {
+        fn $name(
+            centre: [f64; 3],
+            scale: f64,
+            samples: &[([f64; 3], [f64; 6])],
+        ) -> Option<SMatrix<f64, QUADRATIC_TERMS, 6>> {
+            let mut a = SMatrix::<f64, $t, $t>::zeros();
+            let mut rhs = SMatrix::<f64, $t, 6>::zeros();
+            for (p, s) in samples {
+                let d = std::array::from_fn(|j| (p[j] - centre[j]) / scale);
+                let b = basis(d);
+                for i in 0..$t {
+                    for j in 0..$t {
+                        a[(i, j)] += b[i] * b[j];
+                    }
+                    for c in 0..6 {
+                        rhs[(i, c)] += b[i] * s[c];
+                    }
+                }
             }
-            for c in 0..6 {
-                rhs[(i, c)] += b[i] * s[c];
+            // reject near-singular normal matrices (points nearly coplanar for the quadratic
+            // terms)
+            let eig = a.symmetric_eigenvalues();
+            let (lo, hi) = eig.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &v| {
+                (lo.min(v), hi.max(v))
+            });
+            if lo.is_nan() || lo <= 1e-10 * hi {
+                return None;
             }
+            let chol = a.cholesky()?;
+            let x = chol.solve(&rhs);
+            let mut out = SMatrix::<f64, QUADRATIC_TERMS, 6>::zeros();
+            for i in 0..$t {
+                for c in 0..6 {
+                    out[(i, c)] = x[(i, c)];
+                }
+            }
+            Some(out)
         }
-    }
-    // reject near-singular normal matrices (points nearly coplanar for the quadratic terms)
-    let eig = a.clone().symmetric_eigenvalues();
-    let (lo, hi) = eig.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &v| {
-        (lo.min(v), hi.max(v))
-    });
-    if lo.is_nan() || lo <= 1e-10 * hi {
-        return None;
-    }
-    let chol = a.cholesky()?;
-    let x = chol.solve(&rhs);
-    let mut out = SMatrix::<f64, QUADRATIC_TERMS, 6>::zeros();
-    for i in 0..terms {
-        for c in 0..6 {
-            out[(i, c)] = x[(i, c)];
-        }
-    }
-    Some(out)
+    };
 }
+fit_terms!(fit_quadratic_terms, 10);
+fit_terms!(fit_linear_terms, 4);
 
 /// Recovers σ* from the displacements `u` (3 per node, m); see the module documentation.
 pub fn recover_stress(mesh: &TetMesh, material: &Material, u: &[f64]) -> Result<RecoveredStress> {
@@ -214,12 +221,12 @@ pub fn recover_stress(mesh: &TetMesh, material: &Material, u: &[f64]) -> Result<
                 .fold(0.0, f64::max)
                 .max(f64::MIN_POSITIVE);
             let (coefficients, linear) = match (pts.len() >= MIN_POINTS_QUADRATIC)
-                .then(|| fit(centre, scale, &pts, QUADRATIC_TERMS))
+                .then(|| fit_quadratic_terms(centre, scale, &pts))
                 .flatten()
             {
                 Some(c) => (c, false),
                 None => {
-                    let c = fit(centre, scale, &pts, 4).unwrap_or_else(|| {
+                    let c = fit_linear_terms(centre, scale, &pts).unwrap_or_else(|| {
                         // a degenerate patch (cannot happen for valid tetrahedra): the mean
                         let mut c = SMatrix::<f64, QUADRATIC_TERMS, 6>::zeros();
                         for (_, s) in &pts {
@@ -282,7 +289,7 @@ pub(crate) fn fit_quadratic(points: &[[f64; 3]], values: &[f64]) -> Option<Vec<f
         .zip(values)
         .map(|(p, v)| (*p, [*v, 0.0, 0.0, 0.0, 0.0, 0.0]))
         .collect();
-    let c = fit([0.0; 3], 1.0, &samples, QUADRATIC_TERMS)?;
+    let c = fit_quadratic_terms([0.0; 3], 1.0, &samples)?;
     Some((0..QUADRATIC_TERMS).map(|i| c[(i, 0)]).collect())
 }
 

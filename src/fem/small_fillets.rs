@@ -17,10 +17,8 @@
 //! faceted fillet describes ([`super::facets::EdgeKind::Fillet`]). The five committed designs
 //! have no concave fillet below 4 mm, so the ceiling does not touch them.
 
-use std::collections::HashMap;
-
 use super::facets::{EdgeKind, SurfaceEdges};
-use super::stress::point_segment_distance;
+use super::segment_grid::SegmentGrid;
 
 /// Concave fillets below this radius are refined from the second mesh on whatever the first
 /// mesh's indicator says, mm: well below the first mesh's 5 mm elements.
@@ -36,9 +34,7 @@ pub const SMALL_FILLET_REACH_MM: f64 = 10.0;
 /// The kinks of the small concave fillets of a triangulated surface, looked up by position.
 #[derive(Clone, Debug, Default)]
 pub struct SmallFillets {
-    cell: f64,
-    grid: HashMap<[i64; 3], Vec<u32>>,
-    segments: Vec<[[f64; 3]; 2]>,
+    kinks: SegmentGrid,
     radius: Vec<f64>,
 }
 
@@ -52,10 +48,9 @@ impl SmallFillets {
         cell: f64,
     ) -> Self {
         let mut out = SmallFillets {
-            cell,
-            ..SmallFillets::default()
+            kinks: SegmentGrid::new(cell),
+            radius: Vec::new(),
         };
-        let key = |p: [f64; 3]| p.map(|v| (v / cell).floor() as i64);
         for e in &edges.edges {
             if !e.concave {
                 continue;
@@ -68,23 +63,9 @@ impl SmallFillets {
                 },
                 EdgeKind::Flat | EdgeKind::Sharp => continue,
             };
-            if !(r > 0.0 && r < max_radius) {
-                continue;
-            }
-            let s = e.vertices.map(|v| vertices[v as usize]);
-            let id = out.segments.len() as u32;
-            out.segments.push(s);
-            out.radius.push(r);
-            let (lo, hi) = (
-                key(std::array::from_fn(|j| s[0][j].min(s[1][j]))),
-                key(std::array::from_fn(|j| s[0][j].max(s[1][j]))),
-            );
-            for x in lo[0]..=hi[0] {
-                for y in lo[1]..=hi[1] {
-                    for z in lo[2]..=hi[2] {
-                        out.grid.entry([x, y, z]).or_default().push(id);
-                    }
-                }
+            if r > 0.0 && r < max_radius {
+                out.kinks.push(e.vertices.map(|v| vertices[v as usize]));
+                out.radius.push(r);
             }
         }
         out
@@ -92,37 +73,21 @@ impl SmallFillets {
 
     /// Number of kink edges of small concave fillets.
     pub fn len(&self) -> usize {
-        self.segments.len()
+        self.kinks.len()
     }
 
     /// True when the surface has no small concave fillet.
     pub fn is_empty(&self) -> bool {
-        self.segments.is_empty()
+        self.kinks.is_empty()
     }
 
     /// The largest element size at `p`: the least R + [`GRADING`]·d over the kinks within one
     /// cell of `p`, infinite where there is none.
     pub fn ceiling_at(&self, p: [f64; 3]) -> f64 {
-        if self.segments.is_empty() {
-            return f64::INFINITY;
-        }
-        let k = p.map(|v| (v / self.cell).floor() as i64);
-        let mut best = f64::INFINITY;
-        for dx in -1..=1 {
-            for dy in -1..=1 {
-                for dz in -1..=1 {
-                    if let Some(list) = self.grid.get(&[k[0] + dx, k[1] + dy, k[2] + dz]) {
-                        for &i in list {
-                            let d = point_segment_distance(p, self.segments[i as usize]);
-                            if d <= self.cell {
-                                best = best.min(self.radius[i as usize] + GRADING * d);
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        best
+        self.kinks
+            .nearby(p)
+            .map(|(i, d)| self.radius[i] + GRADING * d)
+            .fold(f64::INFINITY, f64::min)
     }
 }
 
