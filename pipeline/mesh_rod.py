@@ -110,13 +110,16 @@ sits near the midpoint of its edge, which catches a wrong order.
 from __future__ import annotations
 
 import argparse
+import ctypes
 import json
 import math
 import os
 import pathlib
+import queue
 import re
 import subprocess
 import sys
+import threading
 import time
 
 import numpy as np
@@ -162,6 +165,81 @@ TET10_EDGES = [(0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3)]
 
 def log(msg: str) -> None:
     print(f"mesh_rod: {msg}", file=sys.stderr, flush=True)
+
+
+# ---------------------------------------------------------------------------------------------
+# Reproducible meshes: each in an allocator arena of its own
+# ---------------------------------------------------------------------------------------------
+
+def fixed_allocator() -> None:
+    """gmsh hands HXT the surface vertices in the order of their memory addresses (`Gmsh2Hxt`
+    collects them in a `std::set<MVertex *>`), and HXT's optimiser decides its ties in that order:
+    the same model and size field made 12,228 or 12,229 nodes depending on what the process had
+    allocated before (its paths' lengths, earlier meshes), and a fresh clone of the project in
+    another folder made another design 5 (issue 21, session 29). So every mesh is made in a thread
+    of its own (`in_fresh_arena`): glibc gives a new thread a new arena, whose blocks it hands out
+    in the order the meshing asks for them, whatever the process did before. Two settings keep it
+    so: the size above which a block is mapped on its own is fixed (glibc raises it as mapped
+    blocks are freed, so a block could sit in the arena on one run and outside it on another),
+    and the number of arenas is raised so that each thread gets a new one. Checked: one process
+    meshing the same model 4 times after allocations of 5 sizes, from two folders, 40 of 40
+    meshes the same (without: 10 of 40 differ)."""
+    try:
+        libc = ctypes.CDLL("libc.so.6")
+    except OSError:  # not glibc
+        return
+    m_mmap_threshold, m_arena_max = -3, -8
+    libc.mallopt(m_mmap_threshold, 128 * 1024)
+    libc.mallopt(m_arena_max, 1024)
+
+
+def in_fresh_arena(fn, *args):
+    """`fn(*args)` in a new thread (a new allocator arena, `fixed_allocator`), which is then
+    parked for the rest of the process: an ended thread's arena, with its free blocks, would be
+    handed to the next thread. Returns what `fn` returns; raises what it raises."""
+    done: dict = {}
+    finished = threading.Event()
+
+    def run():
+        try:
+            done["value"] = fn(*args)
+        except BaseException as e:  # noqa: BLE001 - handed to the caller
+            done["error"] = e
+        finished.set()
+        threading.Event().wait()
+
+    threading.Thread(target=run, daemon=True).start()
+    finished.wait()
+    if "error" in done:
+        raise done["error"]
+    return done["value"]
+
+
+class ArenaWorker:
+    """One mesh of `serve` in a thread with an arena of its own (`in_fresh_arena`): it first
+    runs `prepare` (the next model built while the caller solves the last mesh), then waits for
+    the request's work, runs it, and parks."""
+
+    def __init__(self, prepare):
+        self.jobs: queue.Queue = queue.Queue()
+        self.results: queue.Queue = queue.Queue()
+        threading.Thread(target=self._run, args=(prepare,), daemon=True).start()
+
+    def _run(self, prepare) -> None:
+        prepare()
+        job = self.jobs.get()
+        try:
+            self.results.put((True, job()))
+        except BaseException as e:  # noqa: BLE001 - handed to the caller
+            self.results.put((False, e))
+        threading.Event().wait()
+
+    def run(self, job):
+        self.jobs.put(job)
+        ok, value = self.results.get()
+        if not ok:
+            raise value
+        return value
 
 
 # ---------------------------------------------------------------------------------------------
@@ -458,7 +536,7 @@ def gmsh_volume_mesh(stl: pathlib.Path, size_mm: float, curved: bool, angle_deg:
     import gmsh
 
     t0 = time.perf_counter()
-    gmsh.initialize(["mesh_rod"], readConfigFiles=False)
+    gmsh.initialize(["mesh_rod"], readConfigFiles=False, interruptible=False)
     try:
         set_options(size_mm, curved, size_field is not None, delaunay)
         patches = build_volume(stl, angle_deg, curve_angle_deg, geometry_in, geometry_out)
@@ -561,7 +639,7 @@ def patch_facts(classified: pathlib.Path) -> tuple[dict, dict]:
     STL triangles."""
     import gmsh
 
-    gmsh.initialize(["mesh_rod"], readConfigFiles=False)
+    gmsh.initialize(["mesh_rod"], readConfigFiles=False, interruptible=False)
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.merge(str(classified))
@@ -652,7 +730,7 @@ def gmsh_local_refinement(stl: pathlib.Path, size_mm: float, angle_deg: float, c
         if geometry_out is None:
             raise SystemExit("mesh_rod: local refinement needs --geometry-in or --geometry-out")
         classified = geometry_out
-        gmsh.initialize(["mesh_rod"], readConfigFiles=False)
+        gmsh.initialize(["mesh_rod"], readConfigFiles=False, interruptible=False)
         try:
             gmsh.option.setNumber("General.Terminal", 0)
             gmsh.merge(str(stl))
@@ -666,7 +744,7 @@ def gmsh_local_refinement(stl: pathlib.Path, size_mm: float, angle_deg: float, c
     errors = []
     last = None
     for rounds in range(LOCAL_ROUNDS + 1):
-        gmsh.initialize(["mesh_rod"], readConfigFiles=False)
+        gmsh.initialize(["mesh_rod"], readConfigFiles=False, interruptible=False)
         try:
             # Delaunay: its errors name the surfaces
             set_options(size_mm, False, size_field is not None, delaunay=True)
@@ -751,7 +829,7 @@ def gmsh_surface_kept(stl: pathlib.Path, size_mm: float, msh_out: pathlib.Path,
     import gmsh
 
     t0 = time.perf_counter()
-    gmsh.initialize(["mesh_rod"], readConfigFiles=False)
+    gmsh.initialize(["mesh_rod"], readConfigFiles=False, interruptible=False)
     try:
         for k, v in gmsh_options(size_mm, False, size_field is not None).items():
             gmsh.option.setNumber(k, v)
@@ -986,9 +1064,11 @@ def cmd_serve(args) -> None:
     geometry = pathlib.Path(args.geometry)
     if not stl.is_file():
         raise SystemExit(f"mesh_rod: no such STL file: {stl}")
-    gmsh.initialize(["mesh_rod"], readConfigFiles=False)
+    gmsh.initialize(["mesh_rod"], readConfigFiles=False, interruptible=False)
     gmsh.option.setNumber("General.Terminal", 0)
     state = {"prepared": None}
+    # every mesh, and the model built for it ahead, in a thread of its own (`fixed_allocator`)
+    worker = ArenaWorker(lambda: None)
     try:
         while True:
             line = sys.stdin.readline()
@@ -997,14 +1077,15 @@ def cmd_serve(args) -> None:
             if not line.strip():
                 continue
             try:
-                reply = served_mesh(json.loads(line), stl, geometry, state)
+                request = json.loads(line)
+                reply = worker.run(lambda: served_mesh(request, stl, geometry, state))
             except Exception as e:  # noqa: BLE001 - every failure is replied, then the session ends
                 replies.write(json.dumps({"error": f"{type(e).__name__}: {e}"}) + "\n")
                 replies.flush()
                 return
             replies.write(json.dumps(reply, sort_keys=True) + "\n")
             replies.flush()
-            prepare_next(geometry, state)
+            worker = ArenaWorker(lambda: prepare_next(geometry, state))
     finally:
         gmsh.finalize()
 
@@ -1117,7 +1198,7 @@ def gmsh_step_mesh(step: pathlib.Path, frame: list, scale: float, size_mm: float
     import gmsh
 
     t0 = time.perf_counter()
-    gmsh.initialize(["mesh_rod"], readConfigFiles=False)
+    gmsh.initialize(["mesh_rod"], readConfigFiles=False, interruptible=False)
     try:
         for k, v in gmsh_options(size_mm, True, size_field is not None).items():
             gmsh.option.setNumber(k, v)
@@ -1404,11 +1485,13 @@ def main(argv=None) -> int:
     pv.add_argument("stl")
     pv.add_argument("--geometry", required=True, help="the classified-surface cache, as `mesh --geometry`")
     args = ap.parse_args(argv)
+    fixed_allocator()
     if args.cmd == "serve":
         cmd_serve(args)
         return 0
-    info = {"mesh": cmd_mesh, "mesh-step": cmd_mesh_step, "convert": cmd_convert,
-            "_attempt": cmd_attempt, "_fallback": cmd_fallback}[args.cmd](args)
+    command = {"mesh": cmd_mesh, "mesh-step": cmd_mesh_step, "convert": cmd_convert,
+               "_attempt": cmd_attempt, "_fallback": cmd_fallback}[args.cmd]
+    info = in_fresh_arena(command, args)
     print(json.dumps(info, sort_keys=True))
     return 0
 
