@@ -2,9 +2,11 @@
 //! figures; changing a design's STL or sidecar, the configuration or the program reruns only
 //! the designs concerned.
 //!
-//! The key is the SHA-256 of the program version, the configuration (as JSON), the bytes of its
-//! pressure trace if it has one, the STL bytes and the sidecar bytes. Entries live in `OUT/.cache/<id>.json` (a study without stage 3:
-//! `OUT/.cache/without-fem/<id>.json`), written atomically.
+//! The key is the SHA-256 of the program version, the program itself ([`program_fingerprint`]:
+//! the running executable and the pipeline's mesher scripts), the configuration (as JSON), the
+//! bytes of its pressure trace if it has one, the STL bytes and the sidecar bytes. Entries live in
+//! `OUT/.cache/<id>.json` (a study without stage 3: `OUT/.cache/without-fem/<id>.json`), written
+//! atomically.
 
 use crate::config::StudyConfig;
 use crate::report::atomic_write::write_atomic;
@@ -13,10 +15,45 @@ use serde::{Serialize, de::DeserializeOwned};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
+/// The pipeline scripts whose code stage 1 and stage 3 run.
+const PIPELINE_SCRIPTS: [&str; 2] = ["mesh_rod.py", "step_solid.py"];
+
+/// SHA-256 of the program a study runs: the bytes of the running executable and of the pipeline
+/// scripts it calls. The version number alone did not change with the code: a study after a
+/// change of defaults (the half model, issue 21) reused results the earlier program had made.
+/// Read once per process.
+pub fn program_fingerprint() -> &'static [u8] {
+    static FINGERPRINT: std::sync::OnceLock<Vec<u8>> = std::sync::OnceLock::new();
+    FINGERPRINT.get_or_init(|| {
+        fingerprint_of(
+            std::env::current_exe().ok().as_deref(),
+            &crate::python_env::project_root(),
+        )
+    })
+}
+
+/// SHA-256 of the executable `exe` and of the [`PIPELINE_SCRIPTS`] under `root/pipeline`; a file
+/// that cannot be read keys nothing apart (the version still does).
+fn fingerprint_of(exe: Option<&Path>, root: &Path) -> Vec<u8> {
+    let mut h = Sha256::new();
+    if let Some(bytes) = exe.and_then(|e| std::fs::read(e).ok()) {
+        h.update(b"executable");
+        h.update(bytes);
+    }
+    for name in PIPELINE_SCRIPTS {
+        if let Ok(bytes) = std::fs::read(root.join("pipeline").join(name)) {
+            h.update(name.as_bytes());
+            h.update(bytes);
+        }
+    }
+    h.finalize().to_vec()
+}
+
 /// Content hash of everything a design's results depend on.
 pub fn design_key(stl: &Path, config: &StudyConfig) -> Result<String> {
     let mut h = Sha256::new();
     h.update(env!("CARGO_PKG_VERSION").as_bytes());
+    h.update(program_fingerprint());
     h.update(serde_json::to_vec(config)?);
     // the configuration names the pressure trace; its content counts too (nothing is added
     // without a trace, so the default study's keys stay as they were)
@@ -73,5 +110,30 @@ impl Cache {
             value,
         };
         write_atomic(&self.path(id), &serde_json::to_vec(&entry)?)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The fingerprint follows the mesher script's bytes (and the executable's): a changed
+    /// `mesh_rod.py` keys every design apart, the same bytes in another folder do not.
+    #[test]
+    fn the_program_fingerprint_follows_the_pipeline_scripts() {
+        let roots: Vec<tempfile::TempDir> = (0..3).map(|_| tempfile::tempdir().unwrap()).collect();
+        for (root, text) in roots.iter().zip(["a = 1\n", "a = 1\n", "a = 2\n"]) {
+            std::fs::create_dir(root.path().join("pipeline")).unwrap();
+            std::fs::write(root.path().join("pipeline/mesh_rod.py"), text).unwrap();
+        }
+        let exe = roots[0].path().join("pipeline/mesh_rod.py");
+        let f: Vec<Vec<u8>> = roots
+            .iter()
+            .map(|r| fingerprint_of(None, r.path()))
+            .collect();
+        assert_eq!(f[0], f[1]);
+        assert_ne!(f[0], f[2]);
+        assert_ne!(fingerprint_of(Some(&exe), roots[0].path()), f[0]);
+        assert_eq!(program_fingerprint().len(), 32);
     }
 }
