@@ -187,3 +187,82 @@ fn a_failed_request_ends_the_session_with_the_reason() {
         .to_string();
     assert!(err.contains("the gmsh session has ended"), "{err}");
 }
+
+/// Issue 21, session 29: gmsh hands HXT the surface vertices in the order of their memory
+/// addresses, and HXT's optimiser broke its ties by it, so one session meshing the same request
+/// again (after other meshes, with other paths) could make another mesh: design 5's third
+/// adaptive mesh (its half model) came out with 12,228 or 12,229 nodes, and a fresh clone in
+/// another folder reported another design 5. Every mesh is now made in a thread with an
+/// allocator arena of its own (`mesh_rod.py`, `fixed_allocator`): the same request, four times in
+/// one session into folders of different lengths, and once in a fresh process, gives one file.
+#[test]
+fn the_same_request_gives_the_same_mesh_whatever_came_before() {
+    let dir = tempfile::tempdir().unwrap();
+    // design 5 through the adaptive loop, for its half surface, classification and third size map
+    let run = dir.path().join("loop");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_rodstudy"))
+        .args([
+            "fem",
+            "designs/design5.stl",
+            "--json",
+            "--no-pictures",
+            "--no-buckling",
+        ])
+        .arg("--out")
+        .arg(&run)
+        .current_dir(root())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mesh_dir = run.join("mesh");
+    let half = mesh_dir.join("rod_frame.stl");
+    let field = mesh_dir.join("adapt2/size_field.bin");
+    assert!(half.is_file() && field.is_file());
+    let classified = std::fs::read_dir(&mesh_dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| {
+            let n = p.file_name().unwrap().to_string_lossy().into_owned();
+            n.starts_with("classified-") && n.ends_with(".msh")
+        })
+        .expect("the loop's classified surface");
+    let geometry = dir.path().join("classified.msh");
+    std::fs::copy(&classified, &geometry).unwrap();
+    let meta = |p: &Path| PathBuf::from(format!("{}.json", p.display()));
+    std::fs::copy(meta(&classified), meta(&geometry)).unwrap();
+    let mut session = GmshSession::start(&python(), &script(), &half, &geometry).unwrap();
+    let outs = [
+        "a",
+        "bbbbbbbbbbbbbbbbbbbbbbbbbbbbbbbbbbbbbbbbb",
+        "c/c/c/c/c",
+        "d",
+    ];
+    let files: Vec<Vec<u8>> = outs
+        .iter()
+        .map(|o| {
+            let m = session
+                .mesh(10.0, Some(&field), &dir.path().join(o), "rod")
+                .unwrap();
+            bytes(&m.report.msh)
+        })
+        .collect();
+    let request = MeshRequest {
+        size_mm: 10.0,
+        size_field: Some(&field),
+        geometry: Some(&geometry),
+        name: Some("rod"),
+        native_read: true,
+    };
+    let fresh =
+        mesh_stl_with(&python(), &script(), &half, &request, &dir.path().join("e")).unwrap();
+    for (o, f) in outs.iter().zip(&files) {
+        assert!(
+            f == &files[0],
+            "the mesh made into {o} differs from the first"
+        );
+    }
+    assert!(
+        bytes(&fresh.report.msh) == files[0],
+        "the fresh process's mesh differs"
+    );
+}
