@@ -378,28 +378,47 @@ pub fn curve_onto(
     surface: &SmoothSurface,
     scale: f64,
 ) -> Result<(TetMesh, CurveStats)> {
+    curve_onto_half(mesh, surface, scale, None)
+}
+
+/// [`curve_onto`] for the half model of a symmetric rod when `plane` is `Some((c, tolerance))`
+/// (m): the half's faces on its symmetry plane z = c (within `tolerance`) are the inside of the
+/// whole and are not curved, and its nodes on the plane move within it (their move's z
+/// component dropped), so that the curved half mirrors into a whole without a gap.
+pub fn curve_onto_half(
+    mesh: &TetMesh,
+    surface: &SmoothSurface,
+    scale: f64,
+    plane: Option<(f64, f64)>,
+) -> Result<(TetMesh, CurveStats)> {
     use super::element::{check_jacobian, corner_volume};
     use super::quadrature::TET14;
     use rayon::prelude::*;
+    let on_plane = |n: usize| plane.is_some_and(|(c, tol)| (mesh.nodes()[n][2] - c).abs() <= tol);
     let faces = boundary_faces(mesh)?;
     let mut on_boundary = vec![false; mesh.n_nodes()];
     for f in &faces {
+        if plane.is_some() && f.nodes.iter().all(|&n| on_plane(n)) {
+            continue;
+        }
         for &n in &f.nodes {
             on_boundary[n] = true;
         }
     }
-    let target: Vec<Option<[f64; 3]>> = mesh
-        .nodes()
-        .par_iter()
-        .zip(&on_boundary)
-        .map(|(p, &b)| {
-            if !b {
+    let target: Vec<Option<[f64; 3]>> = (0..mesh.n_nodes())
+        .into_par_iter()
+        .map(|n| {
+            if !on_boundary[n] {
                 return Some([0.0; 3]);
             }
-            let q = p.map(|v| v * scale);
-            surface
-                .smooth_point(q)
-                .map(|s| std::array::from_fn(|j| (s[j] - q[j]) / scale))
+            let q = mesh.nodes()[n].map(|v| v * scale);
+            surface.smooth_point(q).map(|s| {
+                let mut d: [f64; 3] = std::array::from_fn(|j| (s[j] - q[j]) / scale);
+                if on_plane(n) {
+                    d[2] = 0.0;
+                }
+                d
+            })
         })
         .collect();
     let mut stats = CurveStats::default();
@@ -501,7 +520,10 @@ pub struct GeometryCheck {
 
 /// Solves `mesh` again with its boundary on `surface` (millimetres, [`curve_onto`]) under the
 /// loads and options of the rod analysis (with `rod.reuse_symbolic`, the symbolic analysis of
-/// `mesh`'s own solve: the curved mesh has its connectivity), and returns the judged peaks.
+/// `mesh`'s own solve: the curved mesh has its connectivity), and returns the judged peaks. With
+/// a symmetry plane in `rod` (`mirror_plane_z_m`), `mesh` is the half model the analysis solved:
+/// the half is curved ([`curve_onto_half`]), solved as the half and mirrored, as the analysis was
+/// (issue 21, session 29: on the mirrored whole the check solved twice the DOFs).
 pub fn geometry_check(
     mesh: &TetMesh,
     surface: &SmoothSurface,
@@ -511,8 +533,13 @@ pub fn geometry_check(
     rod: &super::rod::RodOptions,
 ) -> Result<GeometryCheck> {
     let start = std::time::Instant::now();
-    let (curved, stats) = curve_onto(mesh, surface, 1e3)?;
-    let sol = super::rod::solve_rod_fields(&curved, material, bores, force_n, rod)?;
+    let plane = rod.mirror_plane_z_m.map(|c| {
+        let (lo, hi) = mesh.bounding_box();
+        let extent = (0..3).map(|j| hi[j] - lo[j]).fold(0.0, f64::max);
+        (c, super::rod::MIRROR_PLANE_TOLERANCE_REL * extent)
+    });
+    let (curved, stats) = curve_onto_half(mesh, surface, 1e3, plane)?;
+    let (_, sol) = super::rod::solve_rod_on(curved, material, bores, force_n, rod)?;
     Ok(GeometryCheck {
         peaks_mpa: [
             sol.result.fx.max_von_mises_away_from_fixed_mpa,

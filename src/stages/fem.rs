@@ -530,15 +530,33 @@ impl Setup {
                 self.edges(),
                 2.0,
             );
-            // the whole mesh, curved
+            // the mesh solved, curved: a half model's half (its first nodes and elements, the
+            // images after them), solved as the half and mirrored; else the whole
+            let half = r.half_model.as_ref().map(|h| {
+                (
+                    h.plane_z_mm * 1e-3,
+                    TetMesh::new(
+                        mesh.nodes()[..h.nodes].to_vec(),
+                        mesh.elements()[..h.elements].to_vec(),
+                    ),
+                )
+            });
             let rod = RodOptions {
                 keep_system: false,
                 reuse_symbolic: symbolic,
-                mirror_plane_z_m: None,
+                mirror_plane_z_m: half.as_ref().map(|(c, _)| *c),
                 ..self.rod.clone()
             };
             let (checked, buckled) = rayon::join(
-                || geometry_check(mesh, &surface, &self.material, &self.bores, force_n, &rod),
+                || match &half {
+                    Some((_, Ok(h))) => {
+                        geometry_check(h, &surface, &self.material, &self.bores, force_n, &rod)
+                    }
+                    Some((_, Err(e))) => Err(crate::fem::FemError::InvalidMesh(e.to_string())),
+                    None => {
+                        geometry_check(mesh, &surface, &self.material, &self.bores, force_n, &rod)
+                    }
+                },
                 buckle,
             );
             let smooth = match checked {
