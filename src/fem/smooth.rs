@@ -684,4 +684,65 @@ mod tests {
         );
         assert!(after < 0.15, "after: {after} of the sagitta");
     }
+
+    /// The half of the plate above its mid-plane (z ≥ 0), curved with the plane: its faces on the
+    /// plane are the whole's inside and stay, its nodes on the plane move within it, and every
+    /// node goes where curving the whole plate puts it (the plate and the smooth surface through
+    /// its vertices are symmetric), so the curved half mirrors into the curved whole.
+    #[test]
+    fn a_half_is_curved_as_the_whole_is_and_its_plane_stays_flat() {
+        use crate::fem::boundary::boundary_faces;
+        use crate::fem::mesh::structured::{TwoEyePlate, two_eye_plate};
+        let whole = two_eye_plate(&TwoEyePlate::default()).unwrap();
+        let faces = boundary_faces(&whole).unwrap();
+        let v: Vec<[f64; 3]> = whole.nodes().iter().map(|x| x.map(|c| c * 1e3)).collect();
+        let t: Vec<[u32; 3]> = faces
+            .iter()
+            .map(|f| [f.nodes[0] as u32, f.nodes[1] as u32, f.nodes[2] as u32])
+            .collect();
+        let edges = SurfaceEdges::new(&v, &t, 40.0, MAX_FILLET_RADIUS_MM);
+        let surface = SmoothSurface::new(&v, &t, &edges, 2.0);
+        let (curved_whole, _) = curve_onto(&whole, &surface, 1e3).unwrap();
+        // the half: the elements at z ≥ 0, its nodes numbered as they come
+        let mut of = vec![usize::MAX; whole.n_nodes()];
+        let mut nodes = Vec::new();
+        let elements: Vec<[usize; 10]> = whole
+            .elements()
+            .iter()
+            .filter(|el| el.iter().all(|&n| whole.nodes()[n][2] >= -1e-12))
+            .map(|el| {
+                el.map(|n| {
+                    if of[n] == usize::MAX {
+                        of[n] = nodes.len();
+                        nodes.push(whole.nodes()[n]);
+                    }
+                    of[n]
+                })
+            })
+            .collect();
+        let half = TetMesh::new(nodes, elements).unwrap();
+        let (curved, stats) = curve_onto_half(&half, &surface, 1e3, Some((0.0, 1e-9))).unwrap();
+        assert_eq!(stats.unmatched_nodes, 0);
+        let (mut plane, mut moved_in_plane) = (0, 0);
+        for (w, &h) in of.iter().enumerate() {
+            if h == usize::MAX {
+                continue;
+            }
+            let (a, b) = (curved_whole.nodes()[w], curved.nodes()[h]);
+            assert!(
+                (v3(a) - v3(b)).norm() < 1e-12,
+                "node {w}: {a:?} against {b:?}"
+            );
+            if half.nodes()[h][2] == 0.0 {
+                plane += 1;
+                assert_eq!(b[2], 0.0, "node {w} left the plane");
+                if (v3(b) - v3(half.nodes()[h])).norm() > 1e-9 {
+                    moved_in_plane += 1;
+                }
+            }
+        }
+        // the bore rims on the plane became round; the rest of the plane stayed
+        assert!(plane > 100 && moved_in_plane > 10 && moved_in_plane < plane / 2);
+        crate::fem::mesh::mirror::mirror(&curved, 0.0, 1e-9).unwrap();
+    }
 }
