@@ -635,8 +635,14 @@ mod tests {
     /// the largest chord's sagitta, measured 11 %: the angle-weighted normals of unequal chords
     /// lean a little; the straight midside nodes were up to a whole sagitta off), the other faces
     /// do not move, and no element is distorted.
-    #[test]
-    fn a_polygonal_bore_is_curved_round_and_the_flat_faces_stay() {
+    /// The default two-eye plate (polygonal bores), its boundary faces, and the smooth surface
+    /// through its boundary's vertices (millimetres), as an STL of the plate would give it.
+    fn plate_and_its_smooth_surface() -> (
+        crate::fem::mesh::structured::TwoEyePlate,
+        TetMesh,
+        Vec<crate::fem::boundary::BoundaryFace>,
+        SmoothSurface,
+    ) {
         use crate::fem::boundary::boundary_faces;
         use crate::fem::mesh::structured::{TwoEyePlate, two_eye_plate};
         let p = TwoEyePlate::default();
@@ -649,6 +655,12 @@ mod tests {
             .collect();
         let edges = SurfaceEdges::new(&v, &t, 40.0, MAX_FILLET_RADIUS_MM);
         let surface = SmoothSurface::new(&v, &t, &edges, 2.0);
+        (p, mesh, faces, surface)
+    }
+
+    #[test]
+    fn a_polygonal_bore_is_curved_round_and_the_flat_faces_stay() {
+        let (p, mesh, faces, surface) = plate_and_its_smooth_surface();
         let (curved, stats) = curve_onto(&mesh, &surface, 1e3).unwrap();
         assert_eq!(stats.unmatched_nodes, 0);
         assert_eq!(stats.damped_nodes, 0);
@@ -691,17 +703,7 @@ mod tests {
     /// its vertices are symmetric), so the curved half mirrors into the curved whole.
     #[test]
     fn a_half_is_curved_as_the_whole_is_and_its_plane_stays_flat() {
-        use crate::fem::boundary::boundary_faces;
-        use crate::fem::mesh::structured::{TwoEyePlate, two_eye_plate};
-        let whole = two_eye_plate(&TwoEyePlate::default()).unwrap();
-        let faces = boundary_faces(&whole).unwrap();
-        let v: Vec<[f64; 3]> = whole.nodes().iter().map(|x| x.map(|c| c * 1e3)).collect();
-        let t: Vec<[u32; 3]> = faces
-            .iter()
-            .map(|f| [f.nodes[0] as u32, f.nodes[1] as u32, f.nodes[2] as u32])
-            .collect();
-        let edges = SurfaceEdges::new(&v, &t, 40.0, MAX_FILLET_RADIUS_MM);
-        let surface = SmoothSurface::new(&v, &t, &edges, 2.0);
+        let (_, whole, _, surface) = plate_and_its_smooth_surface();
         let (curved_whole, _) = curve_onto(&whole, &surface, 1e3).unwrap();
         // the half: the elements at z ≥ 0, its nodes numbered as they come
         let mut of = vec![usize::MAX; whole.n_nodes()];
