@@ -66,23 +66,28 @@ impl RecoveredStress {
     }
 }
 
-/// σ_h at the four Gauss points of every element, with the points' coordinates.
+/// σ_h of each load case at the four Gauss points of every element, with the points'
+/// coordinates (the shape gradients formed once for all cases).
 struct Samples {
     points: Vec<[[f64; 3]; 4]>,
-    stress: Vec<[[f64; 6]; 4]>,
+    /// Per case, per element.
+    stress: Vec<Vec<[[f64; 6]; 4]>>,
 }
 
-/// The four Gauss points of one element and σ_h there.
-type ElementSamples = ([[f64; 3]; 4], [[f64; 6]; 4]);
+/// The four Gauss points of one element and σ_h there, per case.
+type ElementSamples = ([[f64; 3]; 4], Vec<[[f64; 6]; 4]>);
 
-fn gauss_samples(mesh: &TetMesh, material: &Material, u: &[f64]) -> Result<Samples> {
+fn gauss_samples(mesh: &TetMesh, material: &Material, us: &[&[f64]]) -> Result<Samples> {
     let per: Vec<ElementSamples> = (0..mesh.n_elements())
         .into_par_iter()
         .map(|e| {
             let x: ElementCoords = mesh.element_coords(e);
-            let ue = mesh.element_displacements(e, u);
+            let ues: Vec<_> = us
+                .iter()
+                .map(|u| mesh.element_displacements(e, u))
+                .collect();
             let mut pts = [[0.0; 3]; 4];
-            let mut sig = [[0.0; 6]; 4];
+            let mut sig = vec![[[0.0; 6]; 4]; us.len()];
             for (g, xi) in TET4.points.iter().enumerate() {
                 let n = tet10_shape(*xi);
                 for a in 0..10 {
@@ -91,12 +96,21 @@ fn gauss_samples(mesh: &TetMesh, material: &Material, u: &[f64]) -> Result<Sampl
                     }
                 }
                 let (grad, _) = shape_gradients(&x, *xi, e, "quadrature point")?;
-                sig[g] = material.stress(&strain(&grad, &ue));
+                for (c, ue) in ues.iter().enumerate() {
+                    sig[c][g] = material.stress(&strain(&grad, ue));
+                }
             }
             Ok((pts, sig))
         })
         .collect::<Result<_>>()?;
-    let (points, stress) = per.into_iter().unzip();
+    let mut stress = vec![Vec::with_capacity(per.len()); us.len()];
+    let mut points = Vec::with_capacity(per.len());
+    for (p, sig) in per {
+        points.push(p);
+        for (c, s) in sig.into_iter().enumerate() {
+            stress[c].push(s);
+        }
+    }
     Ok(Samples { points, stress })
 }
 
@@ -133,26 +147,26 @@ impl PatchFit {
     }
 }
 
-/// The least-squares fit of the first `$t` basis functions to the samples, on stack matrices (one
-/// per corner node: no allocation); `None` when the normal matrix is near singular.
+/// The least-squares fits of the first `$t` basis functions to the samples at `points`, one per
+/// case (`values[c][i]`: case c at point i), on stack matrices (one normal matrix per corner node,
+/// factorised once for all cases: no allocation); `None` when it is near singular.
 macro_rules! fit_terms {
     ($name:ident, $t:expr) => {
         fn $name(
             centre: [f64; 3],
             scale: f64,
-            samples: &[([f64; 3], [f64; 6])],
-        ) -> Option<SMatrix<f64, QUADRATIC_TERMS, 6>> {
+            points: &[[f64; 3]],
+            values: &[Vec<[f64; 6]>],
+        ) -> Option<Vec<SMatrix<f64, QUADRATIC_TERMS, 6>>> {
+            let bases: Vec<SVector<f64, QUADRATIC_TERMS>> = points
+                .iter()
+                .map(|p| basis(std::array::from_fn(|j| (p[j] - centre[j]) / scale)))
+                .collect();
             let mut a = SMatrix::<f64, $t, $t>::zeros();
-            let mut rhs = SMatrix::<f64, $t, 6>::zeros();
-            for (p, s) in samples {
-                let d = std::array::from_fn(|j| (p[j] - centre[j]) / scale);
-                let b = basis(d);
+            for b in &bases {
                 for i in 0..$t {
                     for j in 0..$t {
                         a[(i, j)] += b[i] * b[j];
-                    }
-                    for c in 0..6 {
-                        rhs[(i, c)] += b[i] * s[c];
                     }
                 }
             }
@@ -166,14 +180,29 @@ macro_rules! fit_terms {
                 return None;
             }
             let chol = a.cholesky()?;
-            let x = chol.solve(&rhs);
-            let mut out = SMatrix::<f64, QUADRATIC_TERMS, 6>::zeros();
-            for i in 0..$t {
-                for c in 0..6 {
-                    out[(i, c)] = x[(i, c)];
-                }
-            }
-            Some(out)
+            Some(
+                values
+                    .iter()
+                    .map(|v| {
+                        let mut rhs = SMatrix::<f64, $t, 6>::zeros();
+                        for (b, s) in bases.iter().zip(v) {
+                            for i in 0..$t {
+                                for c in 0..6 {
+                                    rhs[(i, c)] += b[i] * s[c];
+                                }
+                            }
+                        }
+                        let x = chol.solve(&rhs);
+                        let mut out = SMatrix::<f64, QUADRATIC_TERMS, 6>::zeros();
+                        for i in 0..$t {
+                            for c in 0..6 {
+                                out[(i, c)] = x[(i, c)];
+                            }
+                        }
+                        out
+                    })
+                    .collect(),
+            )
         }
     };
 }
@@ -182,10 +211,24 @@ fit_terms!(fit_linear_terms, 4);
 
 /// Recovers σ* from the displacements `u` (3 per node, m); see the module documentation.
 pub fn recover_stress(mesh: &TetMesh, material: &Material, u: &[f64]) -> Result<RecoveredStress> {
-    let samples = gauss_samples(mesh, material, u)?;
+    Ok(recover_stress_cases(mesh, material, &[u])?
+        .pop()
+        .expect("one case"))
+}
+
+/// [`recover_stress`] of several load cases on one mesh: the Gauss points' shape gradients and
+/// each patch's normal matrix are formed and factorised once for all cases (the same numbers, to
+/// the bit, as a case recovered alone).
+pub fn recover_stress_cases(
+    mesh: &TetMesh,
+    material: &Material,
+    us: &[&[f64]],
+) -> Result<Vec<RecoveredStress>> {
+    let samples = gauss_samples(mesh, material, us)?;
+    let cases = us.len();
     let elems_of = node_elements(mesh);
     let nodes = mesh.nodes();
-    // corner nodes and, for each, its patch fit
+    // corner nodes and, for each, its patch fits
     let mut is_corner = vec![false; mesh.n_nodes()];
     for el in mesh.elements() {
         for &n in &el[..4] {
@@ -193,7 +236,7 @@ pub fn recover_stress(mesh: &TetMesh, material: &Material, u: &[f64]) -> Result<
         }
     }
     let corners: Vec<usize> = (0..mesh.n_nodes()).filter(|&n| is_corner[n]).collect();
-    let fits: Vec<(PatchFit, bool, bool)> = corners
+    let fits: Vec<(Vec<PatchFit>, bool, bool)> = corners
         .par_iter()
         .map(|&n| {
             let mut patch: Vec<u32> = elems_of[n].clone();
@@ -209,76 +252,91 @@ pub fn recover_stress(mesh: &TetMesh, material: &Material, u: &[f64]) -> Result<
                 more.dedup();
                 patch = more;
             }
-            let pts: Vec<([f64; 3], [f64; 6])> = patch
-                .iter()
-                .flat_map(|&e| (0..4).map(move |g| (e as usize, g)))
-                .map(|(e, g)| (samples.points[e][g], samples.stress[e][g]))
+            let at = || {
+                patch
+                    .iter()
+                    .flat_map(|&e| (0..4).map(move |g| (e as usize, g)))
+            };
+            let pts: Vec<[f64; 3]> = at().map(|(e, g)| samples.points[e][g]).collect();
+            let values: Vec<Vec<[f64; 6]>> = (0..cases)
+                .map(|c| at().map(|(e, g)| samples.stress[c][e][g]).collect())
                 .collect();
             let centre = nodes[n];
             let scale = pts
                 .iter()
-                .map(|(p, _)| super::mesh::dist(*p, centre))
+                .map(|p| super::mesh::dist(*p, centre))
                 .fold(0.0, f64::max)
                 .max(f64::MIN_POSITIVE);
             let (coefficients, linear) = match (pts.len() >= MIN_POINTS_QUADRATIC)
-                .then(|| fit_quadratic_terms(centre, scale, &pts))
+                .then(|| fit_quadratic_terms(centre, scale, &pts, &values))
                 .flatten()
             {
                 Some(c) => (c, false),
                 None => {
-                    let c = fit_linear_terms(centre, scale, &pts).unwrap_or_else(|| {
+                    let c = fit_linear_terms(centre, scale, &pts, &values).unwrap_or_else(|| {
                         // a degenerate patch (cannot happen for valid tetrahedra): the mean
-                        let mut c = SMatrix::<f64, QUADRATIC_TERMS, 6>::zeros();
-                        for (_, s) in &pts {
-                            for k in 0..6 {
-                                c[(0, k)] += s[k] / pts.len() as f64;
-                            }
-                        }
-                        c
+                        values
+                            .iter()
+                            .map(|v| {
+                                let mut c = SMatrix::<f64, QUADRATIC_TERMS, 6>::zeros();
+                                for s in v {
+                                    for k in 0..6 {
+                                        c[(0, k)] += s[k] / v.len() as f64;
+                                    }
+                                }
+                                c
+                            })
+                            .collect()
                     });
                     (c, true)
                 }
             };
-            (
-                PatchFit {
+            let fits = coefficients
+                .into_iter()
+                .map(|coefficients| PatchFit {
                     centre,
                     scale,
                     coefficients,
-                },
-                enlarged,
-                linear,
-            )
+                })
+                .collect();
+            (fits, enlarged, linear)
         })
         .collect();
     let mut fit_of = vec![usize::MAX; mesh.n_nodes()];
     for (i, &n) in corners.iter().enumerate() {
         fit_of[n] = i;
     }
-    let mut nodal = vec![[0.0; 6]; mesh.n_nodes()];
-    let mut done = vec![false; mesh.n_nodes()];
-    for &n in &corners {
-        let f = &fits[fit_of[n]].0;
-        nodal[n] = std::array::from_fn(|c| f.coefficients[(0, c)]);
-        done[n] = true;
-    }
-    for el in mesh.elements() {
-        for (k, [a, b]) in TET10_EDGES.iter().enumerate() {
-            let m = el[4 + k];
-            if done[m] {
-                continue;
+    let enlarged_patches = fits.iter().filter(|f| f.1).count();
+    let linear_fits = fits.iter().filter(|f| f.2).count();
+    Ok((0..cases)
+        .map(|c| {
+            let mut nodal = vec![[0.0; 6]; mesh.n_nodes()];
+            let mut done = vec![false; mesh.n_nodes()];
+            for &n in &corners {
+                let f = &fits[fit_of[n]].0[c];
+                nodal[n] = std::array::from_fn(|k| f.coefficients[(0, k)]);
+                done[n] = true;
             }
-            let p = nodes[m];
-            let sa = fits[fit_of[el[*a]]].0.eval(p);
-            let sb = fits[fit_of[el[*b]]].0.eval(p);
-            nodal[m] = std::array::from_fn(|c| 0.5 * (sa[c] + sb[c]));
-            done[m] = true;
-        }
-    }
-    Ok(RecoveredStress {
-        nodal,
-        enlarged_patches: fits.iter().filter(|f| f.1).count(),
-        linear_fits: fits.iter().filter(|f| f.2).count(),
-    })
+            for el in mesh.elements() {
+                for (k, [a, b]) in TET10_EDGES.iter().enumerate() {
+                    let m = el[4 + k];
+                    if done[m] {
+                        continue;
+                    }
+                    let p = nodes[m];
+                    let sa = fits[fit_of[el[*a]]].0[c].eval(p);
+                    let sb = fits[fit_of[el[*b]]].0[c].eval(p);
+                    nodal[m] = std::array::from_fn(|j| 0.5 * (sa[j] + sb[j]));
+                    done[m] = true;
+                }
+            }
+            RecoveredStress {
+                nodal,
+                enlarged_patches,
+                linear_fits,
+            }
+        })
+        .collect())
 }
 
 /// Least-squares helper exposed for tests: fits a quadratic to values at points.
@@ -289,7 +347,9 @@ pub(crate) fn fit_quadratic(points: &[[f64; 3]], values: &[f64]) -> Option<Vec<f
         .zip(values)
         .map(|(p, v)| (*p, [*v, 0.0, 0.0, 0.0, 0.0, 0.0]))
         .collect();
-    let c = fit_quadratic_terms([0.0; 3], 1.0, &samples)?;
+    let pts: Vec<[f64; 3]> = samples.iter().map(|(p, _)| *p).collect();
+    let values = vec![samples.iter().map(|(_, s)| *s).collect()];
+    let c = fit_quadratic_terms([0.0; 3], 1.0, &pts, &values)?.pop()?;
     Some((0..QUADRATIC_TERMS).map(|i| c[(i, 0)]).collect())
 }
 
@@ -358,5 +418,32 @@ mod tests {
         for (a, b) in c.iter().zip(want) {
             assert!((a - b).abs() < 1e-10, "{c:?}");
         }
+    }
+
+    /// Two load cases recovered together give each case's recovery alone, to the bit (the
+    /// shared normal matrices are the same numbers).
+    #[test]
+    fn cases_recovered_together_are_each_recovered_alone() {
+        let mesh = box_tet10(0.04, 0.03, 0.02, 4, 3, 2).unwrap();
+        let m = Material::STEEL;
+        let fields = [
+            |p: [f64; 3]| [1e-3 * p[0] * p[1], 2e-4 * p[2] * p[2], -1e-3 * p[0] * p[2]],
+            |p: [f64; 3]| [3e-4 * p[1].sin(), 1e-3 * p[0] * p[0] * p[1], 5e-4 * p[2]],
+        ];
+        let us: Vec<Vec<f64>> = fields
+            .iter()
+            .map(|f| mesh.nodes().iter().flat_map(|p| f(*p)).collect())
+            .collect();
+        let together =
+            recover_stress_cases(&mesh, &m, &[us[0].as_slice(), us[1].as_slice()]).unwrap();
+        for (u, t) in us.iter().zip(&together) {
+            let alone = recover_stress(&mesh, &m, u).unwrap();
+            let bits = |r: &RecoveredStress| -> Vec<u64> {
+                r.nodal.iter().flatten().map(|v| v.to_bits()).collect()
+            };
+            assert_eq!(bits(&alone), bits(t));
+            assert_eq!(alone.linear_fits, t.linear_fits);
+        }
+        assert_ne!(together[0].nodal, together[1].nodal);
     }
 }
