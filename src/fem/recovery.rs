@@ -150,6 +150,8 @@ impl PatchFit {
 /// The least-squares fits of the first `$t` basis functions to the samples at `points`, one per
 /// case (`values[c][i]`: case c at point i), on stack matrices (one normal matrix per corner node,
 /// factorised once for all cases: no allocation); `None` when it is near singular.
+/// A macro, not a const generic: nalgebra's eigenvalues and Cholesky of an `SMatrix<f64, T, T>`
+/// carry dimension bounds that a generic `T` cannot meet on stable Rust.
 macro_rules! fit_terms {
     ($name:ident, $t:expr) => {
         fn $name(
@@ -342,14 +344,14 @@ pub fn recover_stress_cases(
 /// Least-squares helper exposed for tests: fits a quadratic to values at points.
 #[cfg(test)]
 pub(crate) fn fit_quadratic(points: &[[f64; 3]], values: &[f64]) -> Option<Vec<f64>> {
-    let samples: Vec<([f64; 3], [f64; 6])> = points
-        .iter()
-        .zip(values)
-        .map(|(p, v)| (*p, [*v, 0.0, 0.0, 0.0, 0.0, 0.0]))
-        .collect();
-    let pts: Vec<[f64; 3]> = samples.iter().map(|(p, _)| *p).collect();
-    let values = vec![samples.iter().map(|(_, s)| *s).collect()];
-    let c = fit_quadratic_terms([0.0; 3], 1.0, &pts, &values)?.pop()?;
+    // one case, the values in its first stress component
+    let values = vec![
+        values
+            .iter()
+            .map(|v| [*v, 0.0, 0.0, 0.0, 0.0, 0.0])
+            .collect(),
+    ];
+    let c = fit_quadratic_terms([0.0; 3], 1.0, points, &values)?.pop()?;
     Some((0..QUADRATIC_TERMS).map(|i| c[(i, 0)]).collect())
 }
 

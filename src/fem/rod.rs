@@ -383,9 +383,7 @@ pub fn solve_rod_on(
         let solution = solve_rod_fields(&mesh, material, bores, force_n, options)?;
         return Ok((mesh, solution));
     };
-    let (lo, hi) = mesh.bounding_box();
-    let extent = (0..3).map(|j| hi[j] - lo[j]).fold(0.0, f64::max);
-    let m = super::mesh::mirror::mirror(&mesh, c, MIRROR_PLANE_TOLERANCE_REL * extent)?;
+    let m = super::mesh::mirror::mirror(&mesh, c, mirror_plane_tolerance(&mesh))?;
     let held: Vec<usize> = m.plane_nodes.iter().map(|&n| 3 * n + 2).collect();
     let half = static_cases(&mesh, material, bores, force_n, options, 0.5, &held)?;
     let whole = mirrored_static(&m, half, bores)?;
@@ -403,6 +401,14 @@ pub fn solve_rod_on(
 /// Nodes of a half model within this fraction of its extent from the symmetry plane, on a face
 /// there, are the plane's.
 pub const MIRROR_PLANE_TOLERANCE_REL: f64 = 1e-7;
+
+/// How far from the symmetry plane a node of the half model `mesh` may lie and still be on it:
+/// [`MIRROR_PLANE_TOLERANCE_REL`] times the mesh's largest extent (m).
+pub fn mirror_plane_tolerance(mesh: &TetMesh) -> f64 {
+    let (lo, hi) = mesh.bounding_box();
+    let extent = (0..3).map(|j| hi[j] - lo[j]).fold(0.0, f64::max);
+    MIRROR_PLANE_TOLERANCE_REL * extent
+}
 
 /// The static solution of a half model (`half`, on the half of `m`) as the whole's: the
 /// displacements mirrored, the loads and reactions of both halves, the bores found on the whole.
@@ -470,6 +476,23 @@ pub struct HalfModel {
     pub elements: usize,
     /// Nodes on the symmetry plane (u_z = 0).
     pub plane_nodes: usize,
+}
+
+impl HalfModel {
+    /// The symmetry plane's z in the rod frame, m.
+    pub fn plane_z_m(&self) -> f64 {
+        self.plane_z_mm * 1e-3
+    }
+
+    /// The half model that was solved, out of the mirrored `whole` [`solve_rod_on`] returned: its
+    /// first nodes and elements ([`super::mesh::mirror::MirroredMesh::whole`] puts the images
+    /// after them).
+    pub fn half_of(&self, whole: &TetMesh) -> Result<TetMesh> {
+        TetMesh::new(
+            whole.nodes()[..self.nodes].to_vec(),
+            whole.elements()[..self.elements].to_vec(),
+        )
+    }
 }
 
 /// The first half of [`solve_rod_fields`]: the bores, the two pin loads and the static solution

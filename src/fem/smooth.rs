@@ -533,11 +533,9 @@ pub fn geometry_check(
     rod: &super::rod::RodOptions,
 ) -> Result<GeometryCheck> {
     let start = std::time::Instant::now();
-    let plane = rod.mirror_plane_z_m.map(|c| {
-        let (lo, hi) = mesh.bounding_box();
-        let extent = (0..3).map(|j| hi[j] - lo[j]).fold(0.0, f64::max);
-        (c, super::rod::MIRROR_PLANE_TOLERANCE_REL * extent)
-    });
+    let plane = rod
+        .mirror_plane_z_m
+        .map(|c| (c, super::rod::mirror_plane_tolerance(mesh)));
     let (curved, stats) = curve_onto_half(mesh, surface, 1e3, plane)?;
     let (_, sol) = super::rod::solve_rod_on(curved, material, bores, force_n, rod)?;
     Ok(GeometryCheck {
@@ -629,12 +627,6 @@ mod tests {
         }
     }
 
-    /// A tet10 mesh of a plate with two polygonal bores (16 unequal chords, kinks of 18° to 27°),
-    /// its boundary as the STL: curved onto the smooth surface through its vertices, the bore
-    /// walls, their rims included, become round (every boundary node on its circle within 15 % of
-    /// the largest chord's sagitta, measured 11 %: the angle-weighted normals of unequal chords
-    /// lean a little; the straight midside nodes were up to a whole sagitta off), the other faces
-    /// do not move, and no element is distorted.
     /// The default two-eye plate (polygonal bores), its boundary faces, and the smooth surface
     /// through its boundary's vertices (millimetres), as an STL of the plate would give it.
     fn plate_and_its_smooth_surface() -> (
@@ -658,6 +650,12 @@ mod tests {
         (p, mesh, faces, surface)
     }
 
+    /// A tet10 mesh of a plate with two polygonal bores (16 unequal chords, kinks of 18° to 27°),
+    /// its boundary as the STL: curved onto the smooth surface through its vertices, the bore
+    /// walls, their rims included, become round (every boundary node on its circle within 15 % of
+    /// the largest chord's sagitta, measured 11 %: the angle-weighted normals of unequal chords
+    /// lean a little; the straight midside nodes were up to a whole sagitta off), the other faces
+    /// do not move, and no element is distorted.
     #[test]
     fn a_polygonal_bore_is_curved_round_and_the_flat_faces_stay() {
         let (p, mesh, faces, surface) = plate_and_its_smooth_surface();

@@ -30,7 +30,7 @@ use crate::fem::adapt::{AdaptOptions, GeometrySizes, adaptive_rod};
 use crate::fem::buckling::{BucklingMode, BucklingOptions, BucklingSolution};
 use crate::fem::facets::{FacetScale, MAX_FILLET_RADIUS_MM, SurfaceEdges};
 use crate::fem::refinement::{RefinementStudy, refinement_study};
-use crate::fem::rod::{RodSolution, rod_fields, solve_rod_on, solve_rod_static};
+use crate::fem::rod::{HalfModel, RodSolution, rod_fields, solve_rod_on, solve_rod_static};
 use crate::fem::rod_buckling::rod_buckling;
 use crate::fem::small_fillets::{SMALL_FILLET_RADIUS_MM, SMALL_FILLET_REACH_MM, SmallFillets};
 use crate::fem::smooth::{SmoothSurface, geometry_check};
@@ -530,32 +530,20 @@ impl Setup {
                 self.edges(),
                 2.0,
             );
-            // the mesh solved, curved: a half model's half (its first nodes and elements, the
-            // images after them), solved as the half and mirrored; else the whole
-            let half = r.half_model.as_ref().map(|h| {
-                (
-                    h.plane_z_mm * 1e-3,
-                    TetMesh::new(
-                        mesh.nodes()[..h.nodes].to_vec(),
-                        mesh.elements()[..h.elements].to_vec(),
-                    ),
-                )
-            });
+            // the mesh solved, curved: a half model's half, solved as the half and mirrored;
+            // else the whole
+            let half = r.half_model.as_ref();
             let rod = RodOptions {
                 keep_system: false,
                 reuse_symbolic: symbolic,
-                mirror_plane_z_m: half.as_ref().map(|(c, _)| *c),
+                mirror_plane_z_m: half.map(HalfModel::plane_z_m),
                 ..self.rod.clone()
             };
             let (checked, buckled) = rayon::join(
-                || match &half {
-                    Some((_, Ok(h))) => {
-                        geometry_check(h, &surface, &self.material, &self.bores, force_n, &rod)
-                    }
-                    Some((_, Err(e))) => Err(crate::fem::FemError::InvalidMesh(e.to_string())),
-                    None => {
-                        geometry_check(mesh, &surface, &self.material, &self.bores, force_n, &rod)
-                    }
+                || {
+                    let half_mesh = half.map(|h| h.half_of(mesh)).transpose()?;
+                    let solved = half_mesh.as_ref().unwrap_or(mesh);
+                    geometry_check(solved, &surface, &self.material, &self.bores, force_n, &rod)
                 },
                 buckle,
             );
