@@ -92,6 +92,8 @@ pub struct LoadedDesign {
     pub warnings: Vec<String>,
     /// Vertices merged by the tolerant weld (0 when equality by value closed the surface).
     pub vertices_merged: usize,
+    /// Bodies that do not touch: the gap between the nearest two groups [m] (a lower bound).
+    pub loose_gap_m: Option<f64>,
 }
 
 /// The kind of design file.
@@ -285,6 +287,8 @@ pub fn load_design(stl: &Path) -> Result<LoadedDesign> {
     };
     let (valid, vertices_merged) = validate_welded(weld(&soup), &format).with_context(file)?;
     warnings.extend(valid.warnings);
+    let loose_gap = valid.loose_gap;
+    let mesh_scale = format.step().map_or(scale, |r| r.metres_per_unit);
     let (mesh, mass) = match format.step() {
         Some(report) => (
             valid.mesh.scaled(report.metres_per_unit),
@@ -330,6 +334,7 @@ pub fn load_design(stl: &Path) -> Result<LoadedDesign> {
         pins,
         warnings,
         vertices_merged,
+        loose_gap_m: loose_gap.map(|g| g * mesh_scale),
     })
 }
 
