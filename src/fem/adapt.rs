@@ -726,6 +726,87 @@ mod tests {
         }
     }
 
+    /// A mesher that hands the loop the meshes of `sequence` in turn (the last one again after
+    /// its end), and the loop's stop.
+    fn stop_on(sequence: &[TetMesh], opts: &AdaptOptions) -> (StopReason, usize) {
+        let mut calls = 0;
+        let mut mesher = |_: &MeshAsk<'_>| -> Result<(TetMesh, f64)> {
+            calls += 1;
+            Ok((sequence[(calls - 1).min(sequence.len() - 1)].clone(), 0.0))
+        };
+        let out = adaptive_rod(
+            &mut mesher,
+            &Material::default(),
+            &BoreSpec::default(),
+            7500.0,
+            &RodOptions::default(),
+            opts,
+            &GeometrySizes::NONE,
+        )
+        .unwrap();
+        (out.stop, calls)
+    }
+
+    /// A sequence whose second mesh is coarser at the peak than its first is not called
+    /// converged at the second, however small the estimate (a target of 90 %); it goes on to the
+    /// third (fine again) and converges there. The same fine mesh twice converges at the second.
+    #[test]
+    fn a_mesh_coarsened_at_the_peak_is_not_converged() {
+        use crate::fem::mesh::structured::{TwoEyePlate, two_eye_plate};
+        let fine = two_eye_plate(&TwoEyePlate {
+            n_side: 8,
+            n_radial: 4,
+            n_shank: 16,
+            n_z: 4,
+            ..TwoEyePlate::default()
+        })
+        .unwrap();
+        let coarse = two_eye_plate(&TwoEyePlate::default()).unwrap();
+        let opts = AdaptOptions {
+            target_error_rel: 0.9,
+            max_iterations: 5,
+            ..AdaptOptions::default()
+        };
+        assert_eq!(
+            stop_on(&[fine.clone(), fine.clone()], &opts),
+            (StopReason::Converged, 2)
+        );
+        assert_eq!(
+            stop_on(&[fine.clone(), coarse, fine], &opts),
+            (StopReason::Converged, 3)
+        );
+    }
+
+    /// A loop that cannot refine the peak (the mesher hands back the same mesh) stops at the size
+    /// floor only when the floor is reached there (`min_size_m` above the elements at the peak);
+    /// with a floor far below them it is no floor, and the loop runs to its iteration cap.
+    #[test]
+    fn size_floor_only_at_the_floor() {
+        use crate::fem::mesh::structured::{TwoEyePlate, two_eye_plate};
+        let mesh = two_eye_plate(&TwoEyePlate::default()).unwrap();
+        let strict = AdaptOptions {
+            target_error_rel: 1e-4,
+            max_iterations: 4,
+            ..AdaptOptions::default()
+        };
+        let at_floor = AdaptOptions {
+            min_size_m: 0.05,
+            ..strict.clone()
+        };
+        assert_eq!(
+            stop_on(std::slice::from_ref(&mesh), &at_floor),
+            (StopReason::SizeFloor, 2)
+        );
+        let below = AdaptOptions {
+            min_size_m: 1e-5,
+            ..strict
+        };
+        assert_eq!(
+            stop_on(std::slice::from_ref(&mesh), &below),
+            (StopReason::IterationCap, 4)
+        );
+    }
+
     /// Three values of a power law of order 1.5 (within [1, 2]): the order is observed, and the
     /// estimate is Roache's grid convergence index, 1.25 times the exact error, where that is
     /// above half the last change; with a large refinement ratio the half change is the floor.

@@ -929,7 +929,29 @@ fn check_one_piece(mesh: &TetMesh, fixed_nodes: &[usize]) -> Result<()> {
 
 #[cfg(test)]
 mod tests {
-    use super::{RodOptions, check_one_piece};
+
+    /// The edge band's warning fits the geometry: on an STL a sharp edge may be a fillet cut into
+    /// few facets (a STEP settles it); on a STEP the edge is sharp in the B-rep.
+    #[test]
+    fn the_edge_band_warning_fits_stl_and_step() {
+        let hidden = super::super::stress::Peak {
+            value: 120e6,
+            node: 0,
+            element: None,
+            location_m: [0.01, 0.0, 0.0],
+        };
+        let edges = [[[0.0, 0.0, 0.0], [0.0, 0.0, 0.01]]];
+        let stl = edge_band_warning("fx", &hidden, 100e6, &edges, 3e-3, false);
+        assert!(stl.contains("(a STEP export settles it)"), "{stl}");
+        assert!(stl.contains("10.00 mm from the nearest edge") && stl.contains("20 % above"));
+        let step = edge_band_warning("fx", &hidden, 100e6, &edges, 3e-3, true);
+        assert!(step.contains("sharp in the B-rep"), "{step}");
+        assert!(
+            !step.contains("STEP export") && !step.contains("facets"),
+            "{step}"
+        );
+    }
+    use super::{RodOptions, check_one_piece, edge_band_warning};
     use crate::fem::TetMesh;
     use crate::fem::mesh::structured::box_tet10;
 

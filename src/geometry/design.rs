@@ -620,15 +620,33 @@ fn pin_bore(
             if d.pins.source == PinsSource::Sidecar
                 && surface.probe(centre, axis).open_share() > 0.0 =>
         {
-            // sidecar pins in an open arc? measure the partial bores
-            let near = bores()
+            // sidecar pins in an open arc? measure the partial bores whose circle holds the pin
+            let partials: Vec<&Bore> = bores()
                 .iter()
                 .filter(|b| !b.full && b.axis_v().dot(&axis).abs() > 1f64.to_radians().cos())
+                .collect();
+            let near = partials
+                .iter()
+                .filter(|b| b.distance_from_axis(centre) < b.radius)
                 .min_by(|a, b| {
                     a.distance_from_axis(centre)
                         .total_cmp(&b.distance_from_axis(centre))
                 });
-            let Some(bore) = near else { return Err(e) };
+            let Some(bore) = near else {
+                if partials.is_empty() {
+                    return Err(e);
+                }
+                let seen = partials
+                    .iter()
+                    .map(|b| super::bore_finder::describe(b, d.settings.units))
+                    .collect::<Vec<_>>()
+                    .join("; ");
+                return Err(e.context(format!(
+                    "the rays across the {name} leave the part, and no partial bore the geometry \
+                     shows holds it (partial bores seen: {seen}): correct the pin centre in the \
+                     sidecar"
+                )));
+            };
             let off = bore.distance_from_axis(centre);
             let c = bore.centre_v() / scale;
             let what = format!(
