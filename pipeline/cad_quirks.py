@@ -17,6 +17,8 @@ Each file reproduces what a real export from another CAD system does, so that st
                        its sidecar metres.toml with `units = "m"`
   two_bodies           the plain rod and a loose block 80 mm beyond its small end: two closed
                        shells that do not touch (STL and STEP)
+  moved_bore.step      the plain rod's STEP with the cylinder of bore A moved 3 mm along x off the
+                       edges that bound it (a broken B-rep, as a hand edit leaves it): refused
 
 The sharp re-entrant corners of an exact STEP are `foreign_rods.py`'s plain rod (plain.step).
 manifest.json holds, per rod, the true pin centres, radii and axis (in the units the numbers mean),
@@ -162,8 +164,23 @@ def two_bodies(out: pathlib.Path) -> dict:
             "expect": "mass of both bodies with a warning that they are 80 mm apart; FEM refused"}
 
 
+def moved_bore(out: pathlib.Path) -> dict:
+    volumes, _ = fr.build("plain")
+
+    def move(text: str) -> str:
+        surface = re.search(r"#\d+ = CYLINDRICAL_SURFACE\('',#(\d+),25\.\);", text)
+        placement = re.search(rf"#{surface.group(1)} = AXIS2_PLACEMENT_3D\('',#(\d+),", text)
+        point = re.search(rf"#{placement.group(1)} = CARTESIAN_POINT\('',\(([^,]+),", text)
+        x = float(point.group(1)) + 3.0
+        return text[:point.start(1)] + f"{x:.1f}" + text[point.end(1):]
+
+    write_step(out, "moved_bore", move)
+    return {"files": ["moved_bore.step"], "moved_mm": 3.0,
+            "expect": "refused: bore A's surface lies 3 mm from its edges"}
+
+
 RODS = {"solidworks": solidworks, "bolted_capless": bolted_capless, "metres": metres,
-        "two_bodies": two_bodies}
+        "two_bodies": two_bodies, "moved_bore": moved_bore}
 
 
 def main(argv=None) -> int:

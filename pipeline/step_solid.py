@@ -90,6 +90,33 @@ def shells_outward(md, solids: list) -> tuple:
     return verts, np.concatenate(out) if len(out) > 1 else out[0]
 
 
+# A plane or cylinder further than this share of the part's size from the edges that bound it is a
+# broken B-rep (OpenCASCADE's own tolerances are 1e-7 mm; sloppy exports stay below 1e-3 of the part).
+FACE_EDGE_REL = 1e-3
+
+
+def faces_off_their_edges() -> tuple:
+    """The largest distance from a point of a face's boundary curves (five per curve) to the face's
+    own surface, over the planar and cylindrical faces (their closest points are exact; a B-spline
+    projection may stop at a local minimum): (distance, face, surface type, the point)."""
+    import gmsh
+    worst = (0.0, 0, "", (0.0, 0.0, 0.0))
+    for _, f in gmsh.model.getEntities(2):
+        kind = gmsh.model.getType(2, f)
+        if kind not in ("Plane", "Cylinder"):
+            continue
+        for c in gmsh.model.getAdjacencies(2, f)[1]:
+            lo, hi = gmsh.model.getParametrizationBounds(1, c)
+            ts = [lo[0] + (hi[0] - lo[0]) * k / 4.0 for k in range(5)]
+            pts = np.reshape(gmsh.model.getValue(1, c, ts), (-1, 3))
+            closest, _ = gmsh.model.getClosestPoint(2, f, pts.reshape(-1).tolist())
+            d = np.linalg.norm(pts - np.reshape(closest, (-1, 3)), axis=1)
+            k = int(np.argmax(d))
+            if d[k] > worst[0]:
+                worst = (float(d[k]), f, kind, tuple(pts[k]))
+    return worst
+
+
 def cmd_read(args) -> dict:
     import gmsh
 
@@ -115,6 +142,13 @@ def cmd_read(args) -> dict:
         what = ", ".join(f"{n} {['points', 'curves', 'surfaces'][d]}" for d, n in counts.items()) or "nothing"
         fail(f"{path}: no closed solid in the file (it holds {what}): an open or unsewn shell has no "
              "volume; export the part as a solid")
+    off, face, kind, where = faces_off_their_edges()
+    size = max(gmsh.model.getBoundingBox(-1, -1)[3 + k] - gmsh.model.getBoundingBox(-1, -1)[k] for k in range(3))
+    if off > FACE_EDGE_REL * size:
+        fail(f"{path}: face {face} (a {kind.lower()}) lies {off:.3f} mm from its own edges near "
+             f"({where[0]:.3f}, {where[1]:.3f}, {where[2]:.3f}) mm: the B-rep is inconsistent (a face moved "
+             "off its edges, as a broken export or a hand edit leaves it), so its volume and bores "
+             "cannot be trusted; repair the solid in CAD and export it again, or study its STL")
     fused = False
     if len(solids) > 1:
         out, _ = gmsh.model.occ.fuse([(3, solids[0])], [(3, t) for t in solids[1:]])

@@ -234,3 +234,20 @@ fn a_capless_rod_is_not_ranked_above_complete_rods() {
     };
     assert!(mass("capless") < mass("plain"));
 }
+
+/// A STEP whose bore surface was moved 3 mm off the edges that bound it (a broken B-rep): refused
+/// with the face, the distance (3.000 mm, as moved) and what to do, before any figure is made
+/// from it (the triangulation of such a face gave a 177 mm centre distance and a false 357° arc).
+#[test]
+fn a_face_off_its_own_edges_is_refused() {
+    let e = format!(
+        "{:#}",
+        mass_of_design(&quirks().join("moved_bore.step")).unwrap_err()
+    );
+    assert!(
+        e.contains("moved_bore.step")
+            && e.contains("lies 3.000 mm from its own edges")
+            && e.contains("repair the solid in CAD"),
+        "{e}"
+    );
+}
