@@ -437,6 +437,44 @@ impl EngineConfig {
                 bail!("`{key}` must be a positive number, got {v}");
             }
         }
+        check_upper_bounds(&[
+            (
+                "engine.crank_radius_mm",
+                self.crank_radius_mm,
+                MAX_LENGTH_MM,
+                "mm",
+            ),
+            (
+                "engine.cylinder_bore_mm",
+                self.cylinder_bore_mm,
+                MAX_LENGTH_MM,
+                "mm",
+            ),
+            (
+                "engine.piston_mass_kg",
+                self.piston_mass_kg,
+                MAX_MASS_KG,
+                "kg",
+            ),
+            (
+                "engine.crank_mass_kg",
+                self.crank_mass_kg,
+                MAX_MASS_KG,
+                "kg",
+            ),
+            (
+                "engine.crank_inertia_kgm2",
+                self.crank_inertia_kgm2,
+                MAX_MASS_KG,
+                "kg·m²",
+            ),
+            (
+                "engine.crank_eccentricity_mm",
+                self.crank_eccentricity_mm.abs(),
+                MAX_LENGTH_MM,
+                "mm (in magnitude)",
+            ),
+        ])?;
         let e = self.crank_eccentricity_mm * 1e-3;
         if !e.is_finite() {
             bail!("`engine.crank_eccentricity_mm` must be a finite number");
@@ -465,6 +503,36 @@ impl EngineConfig {
     }
 }
 
+/// Upper bounds of the settings: beyond them a value is a typo or a unit slip, and the stages
+/// would overflow or run for days. The fastest crank of any engine turns below 1e4 rad/s (95 000
+/// rpm); no rod, bore or mesh size reaches 10 m; no structural metal is 100 GPa strong.
+pub const MAX_OMEGA_RAD_S: f64 = 1e4;
+/// Largest length setting, mm (10 m).
+pub const MAX_LENGTH_MM: f64 = 1e4;
+/// Largest strength setting, MPa.
+pub const MAX_STRENGTH_MPA: f64 = 1e5;
+/// Largest safety or load factor.
+pub const MAX_FACTOR: f64 = 1e3;
+/// Largest mass (kg) or inertia (kg·m²) of the engine's parts.
+pub const MAX_MASS_KG: f64 = 1e6;
+/// Most cycle instants (0.01° apart over a revolution).
+pub const MAX_INSTANTS: usize = 36_000;
+
+/// Refuses the first `(key, value, max, unit)` whose value exceeds its max, naming the key.
+fn check_upper_bounds(bounds: &[(&str, f64, f64, &str)]) -> Result<()> {
+    for &(key, v, max, unit) in bounds {
+        if v > max {
+            let unit = if unit.is_empty() {
+                String::new()
+            } else {
+                format!(" {unit}")
+            };
+            bail!("`{key}` = {v:e} is out of range: it must be at most {max:e}{unit}");
+        }
+    }
+    Ok(())
+}
+
 /// Everything a study can be configured with.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -485,7 +553,8 @@ impl StudyConfig {
     pub fn read(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path)
             .with_context(|| format!("{}: cannot read the configuration", path.display()))?;
-        let mut config: StudyConfig = toml::from_str(&text)
+        let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+        let mut config: StudyConfig = toml::from_str(text)
             .with_context(|| format!("{}: invalid configuration", path.display()))?;
         config.engine.resolve(path);
         config
@@ -534,6 +603,70 @@ impl StudyConfig {
                 bail!("`{key}` must be a positive number, got {v}");
             }
         }
+        check_upper_bounds(&[
+            (
+                "driven.omega_rad_s",
+                self.driven.omega_rad_s,
+                MAX_OMEGA_RAD_S,
+                "rad/s (20 000 rpm is 2094 rad/s)",
+            ),
+            ("driven.duration_s", self.driven.duration_s, 3600.0, "s"),
+            (
+                "fem.mesh_size_mm",
+                self.fem.mesh_size_mm,
+                MAX_LENGTH_MM,
+                "mm",
+            ),
+            (
+                "fem.initial_size_mm",
+                self.fem.initial_size_mm,
+                MAX_LENGTH_MM,
+                "mm",
+            ),
+            ("fem.max_size_mm", self.fem.max_size_mm, MAX_LENGTH_MM, "mm"),
+            (
+                "fem.fixed_band_mm",
+                self.fem.fixed_band_mm,
+                MAX_LENGTH_MM,
+                "mm",
+            ),
+            (
+                "fem.singular_band_mm",
+                self.fem.singular_band_mm,
+                MAX_LENGTH_MM,
+                "mm",
+            ),
+            (
+                "criterion.yield_mpa",
+                self.criterion.yield_mpa,
+                MAX_STRENGTH_MPA,
+                "MPa",
+            ),
+            (
+                "material.ultimate_mpa",
+                self.material.ultimate_mpa,
+                MAX_STRENGTH_MPA,
+                "MPa",
+            ),
+            (
+                "criterion.safety_factor",
+                self.criterion.safety_factor,
+                MAX_FACTOR,
+                "",
+            ),
+            (
+                "criterion.fatigue_safety_factor",
+                self.criterion.fatigue_safety_factor,
+                MAX_FACTOR,
+                "",
+            ),
+            (
+                "criterion.buckling_factor",
+                self.criterion.buckling_factor,
+                MAX_FACTOR,
+                "",
+            ),
+        ])?;
         let e = self.fem.youngs_modulus_pa;
         if !(1e9..=1e12).contains(&e) {
             bail!(
@@ -553,10 +686,17 @@ impl StudyConfig {
         if self.fem.max_iterations == 0 || self.fem.max_dofs < 1000 {
             bail!("`fem.max_iterations` must be at least 1 and `fem.max_dofs` at least 1000");
         }
-        if self.cycle.instants < 360 {
+        if !(360..=MAX_INSTANTS).contains(&self.cycle.instants) {
             bail!(
-                "`cycle.instants` must be at least 360, got {}",
+                "`cycle.instants` must lie between 360 and {MAX_INSTANTS} (0.01° apart; each \
+                 instant costs a pass over the mesh), got {}",
                 self.cycle.instants
+            );
+        }
+        if self.fem.max_iterations > 100 {
+            bail!(
+                "`fem.max_iterations` must be at most 100, got {}",
+                self.fem.max_iterations
             );
         }
         if self.material.endurance_mpa >= self.material.ultimate_mpa {

@@ -71,7 +71,15 @@ impl Model {
             if pending.is_empty() {
                 start = d.line;
             }
-            for f in d.fields.iter().filter(|f| !f.is_empty()) {
+            for f in &d.fields {
+                if f.is_empty() {
+                    return Err(error(
+                        path,
+                        d.line,
+                        "an empty field in an element line (`id, n1, n2, ...`): remove the \
+                         extra comma or fill in the node",
+                    ));
+                }
                 pending.push(int(path, d.line, f, "element line")?);
             }
             if pending.len() > n + 1 {
@@ -95,6 +103,16 @@ impl Model {
                             format!("element {id} refers to undefined node {nid}"),
                         )
                     })?;
+                    if nodes.contains(&i) {
+                        return Err(error(
+                            path,
+                            start,
+                            format!(
+                                "element {id} lists node {nid} twice: its {n} nodes must be \
+                                 distinct; check the element's connectivity"
+                            ),
+                        ));
+                    }
                     nodes.push(i);
                 }
                 if self.element_index.insert(id, self.elements.len()).is_some() {

@@ -400,7 +400,18 @@ fn solve_step(
         quadrature: QuadratureChoice::Degree2,
     };
     let sol = solve_static(&problem)?;
-    if sol.residual_rel[0].is_nan() || sol.residual_rel[0] > MAX_RESIDUAL_REL {
+    let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+    if !(sol.residual_rel[0].is_finite() && finite(&sol.displacements[0])) {
+        let largest = problem.loads[0].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        return Err(FemError::InvalidInput(format!(
+            "step {number} (line {}): the solution overflows f64 (non-finite displacements or \
+             residual; largest nodal load {largest:.3e}): the loads, the material constants or \
+             the node coordinates are out of range: check their values and units (*CLOAD, \
+             *DLOAD, *ELASTIC, *NODE)",
+            step.line
+        )));
+    }
+    if sol.residual_rel[0] > MAX_RESIDUAL_REL {
         return Err(FemError::InvalidInput(format!(
             "step {number}: the solution does not satisfy K u = f (relative residual {:.1e}): the \
              supports leave a rigid-body motion free (a mechanism); support the model against \
