@@ -407,9 +407,11 @@ impl EngineConfig {
             return Ok(None);
         };
         let path = path.as_path();
-        let text = std::fs::read_to_string(path)
+        // as the settings: bytes that are not UTF-8 read as U+FFFD (a row holding one is refused
+        // with its line)
+        let bytes = std::fs::read(path)
             .with_context(|| format!("{}: cannot read the pressure trace", path.display()))?;
-        let trace = crate::mechanism::PressureTrace::parse(&text)
+        let trace = crate::mechanism::PressureTrace::parse(&String::from_utf8_lossy(&bytes))
             .map_err(|e| anyhow::anyhow!("{}: invalid pressure trace: {e}", path.display()))?;
         Ok(Some(trace))
     }
@@ -551,8 +553,11 @@ pub struct StudyConfig {
 impl StudyConfig {
     /// Reads and checks a configuration file.
     pub fn read(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path)
+        // bytes that are not UTF-8 (a Latin-1 comment) are read as U+FFFD: in a comment they do
+        // not matter, elsewhere TOML refuses them with their line
+        let bytes = std::fs::read(path)
             .with_context(|| format!("{}: cannot read the configuration", path.display()))?;
+        let text = String::from_utf8_lossy(&bytes);
         let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
         let mut config: StudyConfig = toml::from_str(text)
             .with_context(|| format!("{}: invalid configuration", path.display()))?;

@@ -6,39 +6,11 @@
 //! are read; a closed standard output ends `solve --json` quietly.
 
 use rodstudy::deck::{SolveOptions, read_deck_text, solve_model};
-use rodstudy::fem::mesh::structured::box_tet10;
 use std::path::Path;
 use std::process::{Command, Stdio};
 
-/// A C3D10 cube deck (1 m, 2 × 1 × 1 hexahedra of six tets): the x = 0 face fixed, `material`
-/// after `*MATERIAL`, `load` after `*STATIC`. Returns the text and the line of each marker:
-/// (`*ELASTIC` data, first element line).
-fn cube(material: &str, load: &str) -> (String, usize, usize) {
-    let mesh = box_tet10(1.0, 1.0, 1.0, 2, 1, 1).unwrap();
-    let mut s = String::from("*HEADING\ncube\n*NODE, NSET=ALL\n");
-    for (i, p) in mesh.nodes().iter().enumerate() {
-        s += &format!("{}, {:?}, {:?}, {:?}\n", i + 1, p[0], p[1], p[2]);
-    }
-    s += "*ELEMENT, TYPE=C3D10, ELSET=EALL\n";
-    let first_element = s.lines().count() + 1;
-    for (e, el) in mesh.elements().iter().enumerate() {
-        let ids: Vec<String> = el.iter().map(|n| (n + 1).to_string()).collect();
-        s += &format!("{}, {}\n", e + 1, ids.join(", "));
-    }
-    s += "*NSET, NSET=X0\n";
-    let x0: Vec<String> = (0..mesh.n_nodes())
-        .filter(|&n| mesh.nodes()[n][0] == 0.0)
-        .map(|n| (n + 1).to_string())
-        .collect();
-    s += &(x0.join(", ") + "\n");
-    s += "*MATERIAL, NAME=STEEL\n";
-    let elastic = s.lines().count() + 2;
-    s += material;
-    s += "*SOLID SECTION, ELSET=EALL, MATERIAL=STEEL\n*BOUNDARY\nX0, 1, 3\n*STEP\n*STATIC\n";
-    s += load;
-    s += "*NODE PRINT, NSET=ALL\nU\n*END STEP\n";
-    (s, elastic, first_element)
-}
+mod common;
+use common::cube_deck as cube;
 
 const STEEL: &str = "*ELASTIC\n210e9, 0.3\n*DENSITY\n7800\n";
 /// The far corner (1, 1, 1) is node 12 of the 3 × 2 × 2 corner grid, pulled along x.

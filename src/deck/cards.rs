@@ -545,10 +545,19 @@ impl Model {
             return Err(error(path, state.line, "*STEP without *END STEP"));
         }
         if m.elements.is_empty() {
-            return Err(error(path, 0, "no C3D10/C3D4 elements"));
+            return Err(error(
+                path,
+                0,
+                "no C3D10/C3D4 elements: a deck needs *NODE and *ELEMENT, TYPE=C3D10 (or C3D4) \
+                 cards (an empty or cut-off file has none)",
+            ));
         }
         if m.steps.is_empty() {
-            return Err(error(path, 0, "no *STEP"));
+            return Err(error(
+                path,
+                0,
+                "no *STEP: a deck needs a *STEP with *STATIC, its loads and *END STEP",
+            ));
         }
         Ok(m)
     }

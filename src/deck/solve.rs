@@ -399,7 +399,14 @@ fn solve_step(
         loads: vec![f],
         quadrature: QuadratureChoice::Degree2,
     };
-    let sol = solve_static(&problem)?;
+    // the solver's refusal (a mechanism) names the step; an element's (an inverted one) goes
+    // to with_deck_element unchanged
+    let sol = solve_static(&problem).map_err(|e| match e {
+        FemError::Solver(m) => {
+            FemError::InvalidInput(format!("step {number} (line {}): {m}", step.line))
+        }
+        e => e,
+    })?;
     let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
     if !(sol.residual_rel[0].is_finite() && finite(&sol.displacements[0])) {
         let largest = problem.loads[0].iter().fold(0.0f64, |m, v| m.max(v.abs()));

@@ -292,7 +292,8 @@ pub fn read_step(python: &Path, script: &Path, step: &Path, stl_out: &Path) -> R
             );
         }
         bail!(
-            "{}: the STEP reader failed ({}): {}",
+            "{}: the STEP reader failed ({}: {}): the file is probably malformed: export the part \
+             again as STEP, or study its STL instead",
             step.display(),
             out.status,
             stderr.lines().last().unwrap_or_default()
