@@ -418,6 +418,21 @@ fn settings_and_trace_rows_out_of_range_are_refused_up_front() {
     assert_eq!(o.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("`cycle.instants`"), "{stderr}");
     assert!(!out.path().join("results.json").exists());
+    // the flag that overrides the setting, likewise, once and not per design
+    let design = designs.path().join("design1.stl");
+    let o = rodstudy(
+        &[
+            "dynamics",
+            "driven",
+            "--omega",
+            "1e200",
+            design.to_str().unwrap(),
+        ],
+        &[],
+    );
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("--omega 1e200 is out of range"), "{stderr}");
 }
 
 /// A reader that closes standard output before the command writes (`| head -c 10`) ends the

@@ -358,6 +358,15 @@ fn driven(args: DrivenArgs) -> Result<i32> {
         steps: args.steps.unwrap_or(defaults.steps),
         ..defaults
     };
+    // the flags within the settings' ranges, checked once (not per design)
+    if !(scene.omega_rad_s <= crate::config::MAX_OMEGA_RAD_S) {
+        anyhow::bail!(
+            "--omega {:e} is out of range: it must be at most {:e} rad/s (20 000 rpm is 2094 rad/s)",
+            scene.omega_rad_s,
+            crate::config::MAX_OMEGA_RAD_S
+        );
+    }
+    scene.validate()?;
     let method = match args.method {
         MethodArg::ClosedForm => Method::ClosedForm,
         MethodArg::Multibody => Method::Multibody,
