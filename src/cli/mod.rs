@@ -3,7 +3,7 @@
 //! Exit status: 0 when everything asked for succeeded, 1 when some design failed (the others
 //! are still reported), 2 for a usage error or a failure that stops the whole command.
 //!
-//! Standard output is written through [`out!`] and [`outln!`]: a reader that closes the pipe
+//! Standard output is written through `out!` and `outln!`: a reader that closes the pipe
 //! early (`rodstudy mass … --json | head -c 10`) is a normal end, the command stops quietly
 //! with status 0 (the unwinding runs the destructors: temporary folders are removed).
 

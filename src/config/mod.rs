@@ -1,5 +1,8 @@
 //! Study settings: an optional `rodstudy.toml` at the project root (or `--config FILE`); every
-//! setting has the spec's default, unknown keys are errors.
+//! setting has the spec's default, unknown keys are errors, and a value out of its range (below
+//! the physical floor, above the bounds [`MAX_OMEGA_RAD_S`], [`MAX_LENGTH_MM`], [`MAX_INSTANTS`]
+//! …) is refused naming its key when the file is read, before any design is computed. A UTF-8
+//! byte-order mark is skipped.
 //!
 //! ```toml
 //! [driven]            # scene `driven` (SPEC Stage 2)
