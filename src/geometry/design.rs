@@ -16,13 +16,14 @@
 
 use super::bore_check::RodSurface;
 use super::bore_finder::{Bore, FoundPins, PinSearchError, find_bores, find_pins};
+use super::error::MeshError;
 use super::mass_properties::MassProperties;
 use super::mechanism_frame::{MechanismFrame, RodInFrame};
 use super::sidecar::DesignSettings;
 use super::step::{STEP_SCRIPT, StepReport, is_step, read_step};
 use super::stl_file::{StlFormat, read_stl_file};
-use super::validate::validate;
-use super::weld::{IndexedMesh, weld};
+use super::validate::{ValidMesh, validate};
+use super::weld::{IndexedMesh, near_weld_tolerance, weld, weld_within};
 use crate::python_env::{pipeline_script, python};
 use anyhow::{Context, Result, bail};
 use nalgebra::Vector3;
@@ -38,6 +39,44 @@ pub const PLAUSIBLE_MASS_KG: (f64, f64) = (0.01, 100.0);
 /// a few milligrams or a rod of tonnes inside it in the right ones.
 pub const REFUSED_MASS_KG: (f64, f64) = (1e-6, 1e5);
 
+/// Plausible distance between the pins of a connecting rod [m]: outside it the units are
+/// probably wrong.
+pub const PLAUSIBLE_CENTRE_DISTANCE_M: (f64, f64) = (0.005, 5.0);
+
+/// What to do when a design's size says its units are wrong, fitted to the kind of file: an STL
+/// has no unit of its own (the sidecar's `units` says it); a STEP declares one, which the
+/// sidecar's `units` overrides.
+fn units_advice(file: &Path, format: &DesignFormat, settings: &DesignSettings) -> String {
+    let sidecar = super::sidecar::sidecar_path(file);
+    let sidecar = sidecar.file_name().map_or_else(
+        || sidecar.display().to_string(),
+        |n| n.to_string_lossy().into(),
+    );
+    let now = settings.units.symbol();
+    match format {
+        DesignFormat::Stl(_) => format!(
+            "an STL has no unit of its own: its numbers are read as {now} (`units` in \
+             {sidecar}; mm, cm, m or in)"
+        ),
+        DesignFormat::Step(report) if settings.units_given => format!(
+            "the sidecar's `units = \"{now}\"` overrides the unit the STEP declares ({:.4e} m \
+             per unit of OpenCASCADE's): check it, or remove it to take the declared unit",
+            report.metres_per_unit
+        ),
+        DesignFormat::Step(_) => {
+            let declared = std::fs::read(file)
+                .ok()
+                .and_then(|b| super::step::declared_length_unit(&String::from_utf8_lossy(&b)))
+                .map_or_else(|| "no readable unit".into(), |(name, _)| format!("{name}s"));
+            format!(
+                "the STEP declares {declared}; if its numbers are in another unit (an export \
+                 that declares mm but writes metres), write `units = \"m\"` (or cm, in, mm) in \
+                 {sidecar}: it overrides the declared unit"
+            )
+        }
+    }
+}
+
 /// A design loaded and validated: its settings, its surface in metres and its mass properties.
 pub struct LoadedDesign {
     pub name: String,
@@ -51,6 +90,8 @@ pub struct LoadedDesign {
     /// Where the pins came from and where they are.
     pub pins: Pins,
     pub warnings: Vec<String>,
+    /// Vertices merged by the tolerant weld (0 when equality by value closed the surface).
+    pub vertices_merged: usize,
 }
 
 /// The kind of design file.
@@ -162,6 +203,10 @@ pub struct DesignMass {
     pub format: String,
     pub triangles: usize,
     pub vertices: usize,
+    /// Vertices merged because they lay within the welding tolerance of another (an export's
+    /// rounding); in the JSON only when not 0.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub vertices_merged: usize,
     pub units: String,
     pub density_kg_m3: f64,
     pub volume_m3: f64,
@@ -186,6 +231,10 @@ pub struct DesignMass {
     pub pins: PinsReport,
 }
 
+fn is_zero(n: &usize) -> bool {
+    *n == 0
+}
+
 /// The design name: the sidecar's `name`, else the file stem.
 fn design_name(stl: &Path, settings: &DesignSettings) -> String {
     settings.name.clone().unwrap_or_else(|| {
@@ -201,21 +250,19 @@ pub fn load_design(stl: &Path) -> Result<LoadedDesign> {
     let file = || stl.display().to_string();
     let scale = settings.units.to_metres();
     let (soup, format, mut warnings) = if is_step(stl) {
-        if settings.units != super::sidecar::Units::Mm {
-            bail!(
-                "{}: a STEP file declares its own length unit (OpenCASCADE converts it to mm): remove `units = \"{}\"` from the sidecar; pin centres in a STEP's sidecar are millimetres",
-                stl.display(),
-                settings.units.symbol()
-            );
-        }
         // the exact solid through gmsh/OpenCASCADE, and a triangulation of it for the bore
         // check, the frame and the stage-3 surface
         let python = python().with_context(file)?;
         let dir = tempfile::tempdir().with_context(file)?;
         let surface = dir.path().join("surface.stl");
-        let report = read_step(&python, &pipeline_script(STEP_SCRIPT), stl, &surface)?;
+        let mut report = read_step(&python, &pipeline_script(STEP_SCRIPT), stl, &surface)?;
         let (soup, _) = read_stl_file(&surface).with_context(file)?;
         let mut notes = Vec::new();
+        if settings.units_given {
+            let (metres_per_unit, note) = step_units_override(stl, &settings)?;
+            report.metres_per_unit = metres_per_unit;
+            notes.extend(note);
+        }
         if report.solids_in_file > 1 {
             notes.push(report.description());
         }
@@ -236,21 +283,40 @@ pub fn load_design(stl: &Path) -> Result<LoadedDesign> {
         let (soup, format) = read_stl_file(stl).with_context(file)?;
         (soup, DesignFormat::Stl(format), Vec::new())
     };
-    let valid = validate(weld(&soup)).with_context(file)?;
+    let (valid, vertices_merged) = validate_welded(weld(&soup), &format).with_context(file)?;
     warnings.extend(valid.warnings);
-    let mesh = valid.mesh.scaled(scale);
-    let mass = match format.step() {
-        Some(report) => report.mass_properties(scale, settings.density),
-        None => MassProperties::of_mesh(&mesh, settings.density),
+    let (mesh, mass) = match format.step() {
+        Some(report) => (
+            valid.mesh.scaled(report.metres_per_unit),
+            report.mass_properties(report.metres_per_unit, settings.density),
+        ),
+        None => {
+            let mesh = valid.mesh.scaled(scale);
+            let mass = MassProperties::of_mesh(&mesh, settings.density);
+            (mesh, mass)
+        }
     };
     let pins = place_pins(&settings, &mesh);
     let frame = MechanismFrame::new(pins.crank_m, pins.piston_m, pins.axis).with_context(file)?;
     let (lo, hi) = PLAUSIBLE_MASS_KG;
+    let advice = || units_advice(stl, &format, &settings);
     if !(lo..=hi).contains(&mass.mass) {
         warnings.push(format!(
-            "mass {:.4e} kg is implausible for a connecting rod ({lo}–{hi} kg): are the units right? (sidecar `units`, now {})",
+            "mass {:.4e} kg is implausible for a connecting rod ({lo}–{hi} kg): are the units \
+             right? {}",
             mass.mass,
-            settings.units.symbol()
+            advice()
+        ));
+    }
+    let (short, long) = PLAUSIBLE_CENTRE_DISTANCE_M;
+    if pins.source != PinsSource::Default && !(short..=long).contains(&frame.centre_distance) {
+        warnings.push(format!(
+            "{:.4e} m between the pins is implausible for a connecting rod ({} mm – {} m): are \
+             the units right? {}",
+            frame.centre_distance,
+            short * 1e3,
+            long,
+            advice()
         ));
     }
     Ok(LoadedDesign {
@@ -263,7 +329,78 @@ pub fn load_design(stl: &Path) -> Result<LoadedDesign> {
         frame,
         pins,
         warnings,
+        vertices_merged,
     })
+}
+
+/// The sidecar's `units` for a STEP: its numbers are read in them, whatever unit the file
+/// declares. OpenCASCADE hands over millimetres converted from the declared unit (d mm per
+/// declared unit), so a number n of the file is n·d of its millimetres, and n sidecar units:
+/// metres per OpenCASCADE millimetre = (metres per sidecar unit) / d. A warning names both units
+/// when they differ.
+fn step_units_override(step: &Path, settings: &DesignSettings) -> Result<(f64, Option<String>)> {
+    let bytes = std::fs::read(step).with_context(|| format!("{}: cannot read", step.display()))?;
+    let text = String::from_utf8_lossy(&bytes);
+    let units = settings.units;
+    let Some((declared, mm)) = super::step::declared_length_unit(&text) else {
+        bail!(
+            "{}: the sidecar's `units = \"{}\"` is to override the length unit the STEP file \
+             declares, but the file declares none that can be read (no SI_UNIT of .METRE. nor \
+             an inch or foot CONVERSION_BASED_UNIT): remove `units` to take OpenCASCADE's \
+             reading, or export the STEP again with its unit",
+            step.display(),
+            units.symbol()
+        );
+    };
+    let metres_per_unit = units.to_metres() / mm;
+    let same = (units.to_metres() / (mm * 1e-3) - 1.0).abs() < 1e-12;
+    let note = (!same).then(|| {
+        format!(
+            "the file declares its lengths in {declared}s; the sidecar's `units = \"{}\"` \
+             overrides that: its numbers are read as {} (pin centres in the sidecar too)",
+            units.symbol(),
+            units.symbol()
+        )
+    });
+    Ok((metres_per_unit, note))
+}
+
+/// [`validate`], and when the surface is open, once more after merging the vertices closer than
+/// [`near_weld_tolerance`] (an export that wrote one vertex as `0.0` and as `6.9e-15`): the
+/// validated mesh and how many vertices were merged. A surface that stays open is refused with
+/// the error of the unmerged one, its holes measured.
+fn validate_welded(
+    mesh: IndexedMesh,
+    format: &DesignFormat,
+) -> Result<(ValidMesh, usize), MeshError> {
+    let open = match validate(mesh.clone()) {
+        Err(e @ MeshError::Open { .. }) => e,
+        other => return other.map(|v| (v, 0)),
+    };
+    let (merged, near) = weld_within(&mesh, near_weld_tolerance(&mesh));
+    if near.vertices_merged == 0 {
+        return Err(open);
+    }
+    let mut valid = match validate(merged) {
+        Ok(v) => v,
+        Err(MeshError::Open { .. }) => return Err(open),
+        Err(e) => return Err(e),
+    };
+    let what = match format {
+        DesignFormat::Step(_) => "the STEP's triangulation",
+        DesignFormat::Stl(_) => "the STL",
+    };
+    valid.warnings.push(format!(
+        "{} vertices of {what} lay within {:.1e} file units of another (rounding in the export) \
+         and were merged{}; the surface is closed",
+        near.vertices_merged,
+        near.tolerance,
+        match near.triangles_dropped {
+            0 => String::new(),
+            n => format!(", dropping {n} sliver triangle(s) thinner than that"),
+        }
+    ));
+    Ok((valid, near.vertices_merged))
 }
 
 /// The pins: the sidecar's, else found from the geometry, else (no cylindrical bore at all)
@@ -350,11 +487,11 @@ fn rod_record(d: &LoadedDesign, stl: &Path) -> Result<DesignMass> {
     if !(lo..=hi).contains(&d.mass.mass) {
         bail!(
             "{}: mass {:.4e} kg cannot be a connecting rod's ({lo:e}–{hi:e} kg): the units or \
-             the density are wrong (sidecar `units`, now {}: a millimetre file read as metres \
-             weighs 1e9 times as much; `density`, now {} kg/m³: steel is 7850)",
+             the density are wrong (a part read in units 1000 times too small or too large weighs \
+             1e-9 or 1e9 times its mass; {}; `density`, now {} kg/m³: steel is 7850)",
             stl.display(),
             d.mass.mass,
-            d.settings.units.symbol(),
+            units_advice(stl, &d.format, &d.settings),
             d.settings.density
         );
     }
@@ -572,6 +709,7 @@ fn record(d: &LoadedDesign, stl: &Path, rod: Option<(RodInFrame, f64, f64)>) -> 
         format: d.format.name().to_string(),
         triangles: d.mesh.triangles.len(),
         vertices: d.mesh.vertices.len(),
+        vertices_merged: d.vertices_merged,
         units: d.settings.units.symbol().to_string(),
         density_kg_m3: d.settings.density,
         volume_m3: m.volume,

@@ -18,8 +18,46 @@ impl From<nalgebra::Vector3<f64>> for Location {
 
 impl fmt::Display for Location {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let [x, y, z] = self.0;
-        write!(f, "({x:.6}, {y:.6}, {z:.6})")
+        // a value that {:.6} would print as 0 (a rounding artefact of 1e-14) in full
+        let c = |v: f64| {
+            if v != 0.0 && v.abs() < 5e-7 {
+                format!("{v:e}")
+            } else {
+                format!("{v:.6}")
+            }
+        };
+        write!(f, "({}, {}, {})", c(self.0[0]), c(self.0[1]), c(self.0[2]))
+    }
+}
+
+/// The holes of an open mesh, said for the engineer (see [`super::gaps`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct GapsNote(pub Option<super::gaps::Gaps>);
+
+impl fmt::Display for GapsNote {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let Some(g) = self.0 else { return Ok(()) };
+        write!(
+            f,
+            "; {} hole(s), the widest {:.3e} file units across near {}",
+            g.loops,
+            g.widest,
+            Location::from(g.at)
+        )?;
+        if g.artefact {
+            write!(
+                f,
+                ": a crack far narrower than any feature, vertices that should coincide written \
+                 apart (an export artefact, beyond the welding tolerance): export again with a \
+                 finer tolerance, or merge vertices (e.g. MeshLab's \"Merge Close Vertices\")"
+            )
+        } else {
+            write!(
+                f,
+                ": a missing face, not a rounding: repair the surface in CAD and export it again \
+                 as a closed solid"
+            )
+        }
     }
 }
 
@@ -57,12 +95,14 @@ pub enum MeshError {
         at: Location,
     },
     #[error(
-        "open mesh: {count} boundary edge(s) used by only one triangle (a hole in the surface); e.g. the edge {from} – {to}"
+        "open mesh: {count} boundary edge(s) used by only one triangle (a hole in the surface); e.g. the edge {from} – {to}{gaps}"
     )]
     Open {
         count: usize,
         from: Location,
         to: Location,
+        /// What the holes look like (empty when not measured).
+        gaps: GapsNote,
     },
     #[error(
         "non-manifold mesh: {count} edge(s) shared by more than two triangles; e.g. the edge {from} – {to} ({faces} triangles)"

@@ -3,6 +3,7 @@
 //! The pipeline of this stage, one file per step:
 //! - [`stl_file`]: bytes → triangle soup (binary or ASCII, refusing what is not an STL);
 //! - [`weld`]: soup → indexed mesh, equal vertices merged by value;
+//! - [`gaps`]: the holes of an open surface measured (a crack of rounding or a missing face);
 //! - [`validate`]: closed, manifold, consistently outward (several bodies: one bonded body, with a
 //!   warning), or a precise error;
 //! - [`mass_properties`]: exact polyhedral integration (volume, centroid, inertia, principal axes);
@@ -18,6 +19,7 @@ pub mod bore_check;
 pub mod bore_finder;
 pub mod design;
 pub mod error;
+pub mod gaps;
 pub mod half_solid;
 pub mod mass_properties;
 pub mod mechanism_frame;

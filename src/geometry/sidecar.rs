@@ -1,6 +1,7 @@
 //! The optional sidecar `NAME.toml` beside `NAME.stl` (SPEC "Sidecar").
 //!
-//! Keys: `name` (display name), `units` (`mm` default, `cm`, `m`, `in`), `density` (kg/m³,
+//! Keys: `name` (display name), `units` (`mm` default, `cm`, `m`, `in`; for a STEP the unit its
+//! numbers are read in, overriding the unit the file declares), `density` (kg/m³,
 //! default 7800), `crank_pin` and `piston_pin` (pin centres in file units), `pin_axis` (`"x"`,
 //! `"y"`, `"z"` or a vector `[ax, ay, az]`). Unknown keys and wrong types are errors, so a typo
 //! never silently falls back to a default.
@@ -52,7 +53,7 @@ impl Units {
 #[serde(untagged)]
 pub enum PinAxis {
     Named(String),
-    Vector([f64; 3]),
+    Vector(Vec<f64>),
 }
 
 impl Default for PinAxis {
@@ -71,11 +72,11 @@ pub const DEFAULT_CENTRE_DISTANCE: f64 = 0.18;
 #[serde(deny_unknown_fields)]
 pub struct Sidecar {
     pub name: Option<String>,
-    #[serde(default)]
-    pub units: Units,
+    /// The unit of the file's numbers; for a STEP it overrides the unit the file declares.
+    pub units: Option<Units>,
     pub density: Option<f64>,
-    pub crank_pin: Option<[f64; 3]>,
-    pub piston_pin: Option<[f64; 3]>,
+    pub crank_pin: Option<Vec<f64>>,
+    pub piston_pin: Option<Vec<f64>>,
     pub pin_axis: Option<PinAxis>,
 }
 
@@ -84,6 +85,9 @@ pub struct Sidecar {
 pub struct DesignSettings {
     pub name: Option<String>,
     pub units: Units,
+    /// The sidecar gives `units` (for a STEP: its numbers are read in them, whatever unit the
+    /// file declares).
+    pub units_given: bool,
     pub density: f64,
     /// The pin centres [m], both `Some` when the sidecar gives at least one of them (the other
     /// then the spec's default), both `None` when they are to be found from the geometry.
@@ -120,15 +124,19 @@ impl DesignSettings {
 impl Sidecar {
     /// Fills in defaults, checks the values and converts the pins to metres.
     pub fn resolve(self, source: Option<PathBuf>) -> Result<DesignSettings> {
-        let scale = self.units.to_metres();
+        let units = self.units.unwrap_or_default();
+        let scale = units.to_metres();
         let density = self.density.unwrap_or(DEFAULT_DENSITY);
         if !(density.is_finite() && density > 0.0) {
             bail!("`density` must be a positive number of kg/m³, got {density}");
         }
         let given = self.crank_pin.is_some() || self.piston_pin.is_some();
-        let crank = Vector3::from(self.crank_pin.unwrap_or([0.0; 3]));
-        let piston = match self.piston_pin {
-            Some(p) => Vector3::from(p),
+        let crank = match &self.crank_pin {
+            Some(p) => Vector3::from(three("crank_pin", p)?),
+            None => Vector3::zeros(),
+        };
+        let piston = match &self.piston_pin {
+            Some(p) => Vector3::from(three("piston_pin", p)?),
             None => crank + Vector3::x() * (DEFAULT_CENTRE_DISTANCE / scale),
         };
         for (key, p) in [("crank_pin", crank), ("piston_pin", piston)] {
@@ -147,7 +155,7 @@ impl Sidecar {
                 }
             }),
             Some(PinAxis::Vector(v)) => {
-                let v = Vector3::from(*v);
+                let v = Vector3::from(three("pin_axis", v)?);
                 if !(v.iter().all(|c| c.is_finite()) && v.norm() > 0.0) {
                     bail!("`pin_axis` must be a non-zero finite vector, got {v:?}");
                 }
@@ -156,13 +164,25 @@ impl Sidecar {
         };
         Ok(DesignSettings {
             name: self.name,
-            units: self.units,
+            units,
+            units_given: self.units.is_some(),
             density,
             crank_pin_m: given.then(|| crank * scale),
             piston_pin_m: given.then(|| piston * scale),
             pin_axis: axis,
             source,
         })
+    }
+}
+
+/// A point or vector of the sidecar: exactly three numbers.
+fn three(key: &str, v: &[f64]) -> Result<[f64; 3]> {
+    match v {
+        &[x, y, z] => Ok([x, y, z]),
+        _ => bail!(
+            "`{key}` must have 3 coordinates [x, y, z], got {} ({v:?})",
+            v.len()
+        ),
     }
 }
 
@@ -222,5 +242,24 @@ mod tests {
         assert!(bad.resolve(None).is_err());
         let bad: Sidecar = toml::from_str("pin_axis = \"w\"").unwrap();
         assert!(bad.resolve(None).is_err());
+        // a fourth coordinate, or a missing third, is named, never dropped or padded
+        for (text, key) in [
+            (
+                "crank_pin = [0, 0, 0, 99]",
+                "`crank_pin` must have 3 coordinates",
+            ),
+            (
+                "piston_pin = [180.0, 0.0]",
+                "`piston_pin` must have 3 coordinates",
+            ),
+            (
+                "pin_axis = [0, 0, 1, 0]",
+                "`pin_axis` must have 3 coordinates",
+            ),
+        ] {
+            let bad: Sidecar = toml::from_str(text).unwrap();
+            let e = bad.resolve(None).unwrap_err().to_string();
+            assert!(e.contains(key), "{text}: {e}");
+        }
     }
 }

@@ -39,6 +39,53 @@ pub fn is_step(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("step") || e.eq_ignore_ascii_case("stp"))
 }
 
+/// The length unit a STEP file declares (ISO 10303-41: an `SI_UNIT` of `.METRE.` with an
+/// optional prefix, or a `CONVERSION_BASED_UNIT` such as `'INCH'`), as its name and millimetres
+/// per unit; `None` when the file declares none that is recognised. A conversion-based unit
+/// wins over the SI unit it is defined by; else the first SI length unit of the file counts.
+pub fn declared_length_unit(text: &str) -> Option<(String, f64)> {
+    let upper = text.to_ascii_uppercase();
+    let mut si = None;
+    for entity in upper.split(';') {
+        let compact: String = entity.chars().filter(|c| !c.is_whitespace()).collect();
+        if !compact.contains("LENGTH_UNIT(") {
+            continue;
+        }
+        if let Some(at) = compact.find("CONVERSION_BASED_UNIT('") {
+            let name = compact[at + 23..].split('\'').next().unwrap_or_default();
+            let mm = match name {
+                "INCH" | "INCHES" => 25.4,
+                "FOOT" | "FEET" => 304.8,
+                "MILLIMETRE" | "MILLIMETER" | "MM" => 1.0,
+                "METRE" | "METER" | "M" => 1000.0,
+                _ => continue,
+            };
+            return Some((name.to_ascii_lowercase(), mm));
+        }
+        if let Some(at) = compact.find("SI_UNIT(") {
+            let args = compact[at + 8..].split(')').next().unwrap_or_default();
+            let mut parts = args.split(',');
+            let (Some(prefix), Some(unit)) = (parts.next(), parts.next()) else {
+                continue;
+            };
+            if unit != ".METRE." {
+                continue;
+            }
+            let (name, mm) = match prefix {
+                ".MILLI." => ("millimetre", 1.0),
+                ".CENTI." => ("centimetre", 10.0),
+                ".DECI." => ("decimetre", 100.0),
+                "$" => ("metre", 1000.0),
+                ".MICRO." => ("micrometre", 1e-3),
+                ".KILO." => ("kilometre", 1e6),
+                _ => continue,
+            };
+            si = si.or(Some((name.to_string(), mm)));
+        }
+    }
+    si
+}
+
 /// What `step_solid.py read` reports (file units).
 #[derive(Debug, Clone, Deserialize)]
 pub struct StepReport {
@@ -55,6 +102,15 @@ pub struct StepReport {
     pub stl: std::path::PathBuf,
     pub triangles: usize,
     pub gmsh_version: String,
+    /// Metres per unit of the reported lengths (OpenCASCADE's millimetres, 1e-3), or, when the
+    /// sidecar's `units` overrides the unit the file declares, the sidecar's unit over the
+    /// declared one (a file that declares mm but holds metres: 1 m per 1 mm of OpenCASCADE's).
+    #[serde(skip, default = "millimetre")]
+    pub metres_per_unit: f64,
+}
+
+fn millimetre() -> f64 {
+    1e-3
 }
 
 impl StepReport {
@@ -343,5 +399,21 @@ mod tests {
             "{e}"
         );
         assert!(e.contains("export the part again"), "{e}");
+    }
+
+    #[test]
+    fn declared_units_are_read_as_written() {
+        // as gmsh (OpenCASCADE) writes mm, as CAD systems write metres and inches
+        let mm = "#1393 = ( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.) );";
+        assert_eq!(declared_length_unit(mm), Some(("millimetre".into(), 1.0)));
+        let m = "#12=(LENGTH_UNIT()NAMED_UNIT(*)SI_UNIT($,.METRE.));\n#13=(NAMED_UNIT(*)PLANE_ANGLE_UNIT()SI_UNIT($,.RADIAN.));";
+        assert_eq!(declared_length_unit(m), Some(("metre".into(), 1000.0)));
+        let inch = "#7 = ( CONVERSION_BASED_UNIT('INCH',#8) LENGTH_UNIT() NAMED_UNIT(#9) );\n#8 = LENGTH_MEASURE_WITH_UNIT(LENGTH_MEASURE(25.4),#10);";
+        assert_eq!(declared_length_unit(inch), Some(("inch".into(), 25.4)));
+        // angles only: none
+        assert_eq!(
+            declared_length_unit("#13=(NAMED_UNIT(*)PLANE_ANGLE_UNIT()SI_UNIT($,.RADIAN.));"),
+            None
+        );
     }
 }

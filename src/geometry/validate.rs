@@ -19,7 +19,7 @@
 //! empty wedges must have zero width (two coincident faces: a face contact). Two solids
 //! meeting along an edge only, or edges that do not alternate, stay non-manifold errors.
 
-use super::error::{Location, MeshError};
+use super::error::{GapsNote, Location, MeshError};
 use super::mass_properties::signed_volume_and_flagged;
 use super::weld::IndexedMesh;
 use nalgebra::Vector3;
@@ -233,7 +233,12 @@ fn check_edges(mesh: &IndexedMesh, ranges: usize) -> Result<Vec<u32>, MeshError>
     };
     if let (count, Some(d)) = first_of(|d| d.open.len()) {
         let (from, to) = location(defects[d].open[0]);
-        return Err(MeshError::Open { count, from, to });
+        return Err(MeshError::Open {
+            count,
+            from,
+            to,
+            gaps: GapsNote(super::gaps::measure_gaps(mesh)),
+        });
     }
     if let (count, Some(d)) = first_of(|d| d.non_manifold.len()) {
         let (key, faces) = defects[d].non_manifold[0];

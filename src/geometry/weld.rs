@@ -244,6 +244,117 @@ impl VertexTable {
     }
 }
 
+/// Relative welding tolerance of [`weld_within`]: a share of the bounding-box diagonal, far below
+/// any real feature of a part (1e-9 of a 600 mm rod is 0.6 nm).
+pub const NEAR_WELD_REL: f64 = 1e-9;
+
+/// Single-precision units in the last place of the largest coordinate that [`weld_within`] also
+/// merges: an exporter's own rounding of a coordinate it computed twice.
+pub const NEAR_WELD_ULPS: f64 = 4.0;
+
+/// What [`weld_within`] did.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct NearWeld {
+    /// Vertices merged into a neighbour closer than the tolerance.
+    pub vertices_merged: usize,
+    /// Triangles dropped because two of their corners became one vertex (slivers thinner than
+    /// the tolerance).
+    pub triangles_dropped: usize,
+    /// The tolerance used, in the mesh's units.
+    pub tolerance: f64,
+}
+
+/// The welding tolerance of a mesh: [`NEAR_WELD_REL`] of its bounding-box diagonal, or
+/// [`NEAR_WELD_ULPS`] single-precision ulps of its largest coordinate, whichever is larger.
+pub fn near_weld_tolerance(mesh: &IndexedMesh) -> f64 {
+    let (lo, hi) = mesh.bounding_box();
+    let diagonal = (hi - lo).norm();
+    let largest = lo.abs().max().max(hi.abs().max());
+    let ulp = largest * f64::from(f32::EPSILON);
+    (NEAR_WELD_REL * diagonal).max(NEAR_WELD_ULPS * ulp)
+}
+
+/// Merges vertices closer than `tolerance` to each other (a SolidWorks export writes one vertex
+/// as `0.0` in one facet and `6.9e-15` in its neighbour, so equality by value leaves the surface
+/// open along those edges).
+///
+/// Vertices are hashed into a grid of cells of the tolerance's size; each vertex is compared with
+/// the vertices of its own and the 26 neighbouring cells, and joined (union–find) to every one
+/// within the tolerance. Each group becomes its lowest-numbered vertex, so the numbering of the
+/// vertices that stay follows the original order, and a mesh with nothing to merge comes back
+/// unchanged. Triangles with two corners in one group are dropped.
+pub fn weld_within(mesh: &IndexedMesh, tolerance: f64) -> (IndexedMesh, NearWeld) {
+    use std::collections::HashMap;
+    let n = mesh.vertices.len();
+    let cell = |v: &Vector3<f64>| {
+        [
+            (v.x / tolerance).floor() as i64,
+            (v.y / tolerance).floor() as i64,
+            (v.z / tolerance).floor() as i64,
+        ]
+    };
+    let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::with_capacity(n);
+    for (i, v) in mesh.vertices.iter().enumerate() {
+        grid.entry(cell(v)).or_default().push(i as u32);
+    }
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    fn root(parent: &mut [u32], mut i: u32) -> u32 {
+        while parent[i as usize] != i {
+            parent[i as usize] = parent[parent[i as usize] as usize];
+            i = parent[i as usize];
+        }
+        i
+    }
+    for (i, v) in mesh.vertices.iter().enumerate() {
+        let c = cell(v);
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    let Some(others) = grid.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) else {
+                        continue;
+                    };
+                    for &j in others {
+                        if j as usize > i && (mesh.vertices[j as usize] - v).norm() <= tolerance {
+                            let (a, b) = (root(&mut parent, i as u32), root(&mut parent, j));
+                            if a != b {
+                                parent[a.max(b) as usize] = a.min(b);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let mut number = vec![u32::MAX; n];
+    let mut vertices = Vec::with_capacity(n);
+    for i in 0..n as u32 {
+        let r = root(&mut parent, i);
+        if r == i {
+            number[i as usize] = vertices.len() as u32;
+            vertices.push(mesh.vertices[i as usize]);
+        }
+    }
+    let mut triangles = Vec::with_capacity(mesh.triangles.len());
+    for t in &mesh.triangles {
+        let [a, b, c] = t.map(|v| number[root(&mut parent, v) as usize]);
+        if a != b && b != c && a != c {
+            triangles.push([a, b, c]);
+        }
+    }
+    let report = NearWeld {
+        vertices_merged: n - vertices.len(),
+        triangles_dropped: mesh.triangles.len() - triangles.len(),
+        tolerance,
+    };
+    (
+        IndexedMesh {
+            vertices,
+            triangles,
+        },
+        report,
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -339,5 +450,36 @@ mod tests {
     fn widening_is_exact() {
         let soup = [[[0.1f32, 0.2, 0.3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]];
         assert_eq!(weld(&soup).vertices[0].x, f64::from(0.1f32));
+    }
+    #[test]
+    fn near_duplicates_weld_within_the_tolerance_and_nothing_else() {
+        // two triangles sharing an edge whose second copy is 6.9e-15 off (a SolidWorks export)
+        let mesh = IndexedMesh {
+            vertices: vec![
+                Vector3::new(0.0, 0.0, 0.0),
+                Vector3::new(1.0, 0.0, 0.0),
+                Vector3::new(0.0, 1.0, 0.0),
+                Vector3::new(1.0, 6.9e-15, 0.0),
+                Vector3::new(0.0, 1.0, -5.4e-14),
+                Vector3::new(1.0, 1.0, 0.0),
+            ],
+            triangles: vec![[0, 1, 2], [3, 5, 4]],
+        };
+        let tol = near_weld_tolerance(&mesh);
+        // 4 ulps of 1.0 in f32 (4.8e-7) dominate 1e-9 of the diagonal here
+        assert!((tol - 4.0 * f64::from(f32::EPSILON)).abs() < 1e-20, "{tol}");
+        let (welded, report) = weld_within(&mesh, tol);
+        assert_eq!(report.vertices_merged, 2);
+        assert_eq!(report.triangles_dropped, 0);
+        assert_eq!(welded.vertices.len(), 4);
+        assert_eq!(welded.triangles, vec![[0, 1, 2], [1, 3, 2]]);
+        // a real gap (1e-3) stays open
+        let mut gap = mesh.clone();
+        gap.vertices[3].y = 1e-3;
+        let (_, report) = weld_within(&gap, tol);
+        assert_eq!(report.vertices_merged, 1);
+        // nothing to merge: the same mesh back
+        let (same, report) = weld_within(&welded, tol);
+        assert_eq!((same, report.vertices_merged), (welded, 0));
     }
 }

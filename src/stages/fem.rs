@@ -345,9 +345,9 @@ impl Setup {
             keep_system: keep_system || (for_gmsh && design.format.step().is_none()),
             ..RodOptions::default()
         };
-        let step = design.format.step().map(|_| {
+        let step = design.format.step().map(|report| {
             let f = &design.frame;
-            let to_metres = design.settings.units.to_metres();
+            let to_metres = report.metres_per_unit;
             StepInRodFrame {
                 step: design.file.clone(),
                 origin: (f.origin / to_metres).into(),

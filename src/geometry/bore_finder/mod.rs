@@ -128,35 +128,25 @@ pub fn find_pins(
             None => families.push(vec![b]),
         }
     }
-    let pair_area = |f: &Vec<&Bore>| f[0].area + f[1].area;
-    let mut pairs: Vec<&Vec<&Bore>> = families.iter().filter(|f| f.len() >= 2).collect();
-    if pairs.is_empty() {
-        return Err(PinSearchError::NotParallel(list(
-            &cands.iter().collect::<Vec<_>>(),
-        )));
+    let seen = list(&cands.iter().collect::<Vec<_>>());
+    if families.iter().all(|f| f.len() < 2) {
+        return Err(PinSearchError::NotParallel(seen));
     }
-    pairs.sort_by(|a, b| pair_area(b).total_cmp(&pair_area(a)));
-    if pairs.len() > 1 && pair_area(pairs[1]) >= COMPARABLE_AREA * pair_area(pairs[0]) {
-        return Err(PinSearchError::NotParallel(list(
-            &[&pairs[0][..2], &pairs[1][..2]].concat(),
-        )));
-    }
-    let family = pairs[0];
-    let competitors: Vec<&Bore> = family[2..]
-        .iter()
-        .copied()
-        .filter(|b| b.area >= COMPARABLE_AREA * family[1].area)
-        .collect();
-    if !competitors.is_empty() {
-        let all: Vec<&Bore> = family[..2].iter().chain(&competitors).copied().collect();
-        return Err(PinSearchError::Ambiguous {
-            count: all.len(),
-            list: list(&all),
-        });
-    }
-    let (p, q) = (family[0], family[1]);
+    let (p, q) = match pair_at_the_ends(mesh, &families) {
+        Some(Ok(pair)) => pair,
+        Some(Err(rivals)) => {
+            return Err(PinSearchError::Ambiguous {
+                count: rivals,
+                list: seen,
+            });
+        }
+        None => pair_by_wall_area(&families, &seen)?,
+    };
     if (p.radius - q.radius).abs() <= EQUAL_RADII_REL * p.radius.max(q.radius) {
-        return Err(PinSearchError::EqualRadii(list(&[p, q])));
+        return Err(PinSearchError::EqualRadii(format!(
+            "{}; all bores seen: {seen}",
+            list(&[p, q])
+        )));
     }
     let (crank, piston) = if p.radius > q.radius { (p, q) } else { (q, p) };
     let (a, b) = (crank.axis_v(), piston.axis_v());
@@ -166,7 +156,10 @@ pub fn find_pins(
     if centre_distance <= crank.radius + piston.radius {
         return Err(PinSearchError::Ambiguous {
             count: 2,
-            list: format!("{} (the two bores overlap)", list(&[crank, piston])),
+            list: format!(
+                "{} (the two bores overlap); all bores seen: {seen}",
+                list(&[crank, piston])
+            ),
         });
     }
     Ok(FoundPins {
@@ -175,4 +168,118 @@ pub fn find_pins(
         axis: axis.into(),
         centre_distance,
     })
+}
+
+/// The pin pair a rod is built around: two parallel bores at the two ends of the part's long
+/// extent. The long direction ℓ is the principal direction of the largest second moment of the
+/// surface (area-weighted triangle centroids). A family of parallel bores may hold the pins only
+/// if its axis is across ℓ (|a·ℓ| ≤ cos 60°: cap-bolt holes run along the rod, oil holes across
+/// the pin axis are another family); within it, a pair qualifies when the line between the two
+/// axes runs along ℓ (within 30°) and the two bores span at least half the part's extent along
+/// that line (d + r₁ + r₂ ≥ ½ extent). The qualifying pair farthest apart wins; another pair
+/// within 2 % of its distance (and not sharing both bores) makes the choice ambiguous:
+/// `Some(Err(count))`. `None` when no pair qualifies (a part that is no elongated rod): the
+/// caller falls back on wall area.
+fn pair_at_the_ends<'a>(
+    mesh: &IndexedMesh,
+    families: &[Vec<&'a Bore>],
+) -> Option<Result<(&'a Bore, &'a Bore), usize>> {
+    let long = long_direction(mesh)?;
+    let extent = |u: Vector3<f64>| {
+        let (lo, hi) = mesh
+            .vertices
+            .iter()
+            .map(|v| v.dot(&u))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                (lo.min(x), hi.max(x))
+            });
+        hi - lo
+    };
+    let mut pairs: Vec<(f64, &Bore, &Bore)> = Vec::new();
+    for family in families.iter().filter(|f| f.len() >= 2) {
+        let a = family[0].axis_v();
+        if a.dot(&long).abs() > 60f64.to_radians().cos() {
+            continue;
+        }
+        let along = (long - a * a.dot(&long)).normalize();
+        for (i, p) in family.iter().enumerate() {
+            for q in &family[i + 1..] {
+                let d = q.centre_v() - p.centre_v();
+                let d = d - a * a.dot(&d);
+                let distance = d.norm();
+                if distance <= p.radius + q.radius {
+                    continue;
+                }
+                let u = d / distance;
+                if u.dot(&along).abs() < 30f64.to_radians().cos() {
+                    continue;
+                }
+                if distance + p.radius + q.radius >= 0.5 * extent(u) {
+                    pairs.push((distance, p, q));
+                }
+            }
+        }
+    }
+    pairs.sort_by(|x, y| y.0.total_cmp(&x.0));
+    let &(best, p, q) = pairs.first()?;
+    let rivals = pairs[1..]
+        .iter()
+        .filter(|(d, r, s)| *d >= 0.98 * best && !(std::ptr::eq(*r, p) && std::ptr::eq(*s, q)))
+        .count();
+    Some(if rivals == 0 {
+        Ok((p, q))
+    } else {
+        Err(rivals + 2)
+    })
+}
+
+/// The unit direction of the largest second moment of the surface about its centroid
+/// (area-weighted triangle centroids); `None` for an empty surface.
+fn long_direction(mesh: &IndexedMesh) -> Option<Vector3<f64>> {
+    let mut area = 0.0;
+    let mut first = Vector3::zeros();
+    let mut second = nalgebra::Matrix3::zeros();
+    for t in 0..mesh.triangles.len() {
+        let [a, b, c] = mesh.corners(t);
+        let w = 0.5 * (b - a).cross(&(c - a)).norm();
+        let m = (a + b + c) / 3.0;
+        area += w;
+        first += m * w;
+        second += m * m.transpose() * w;
+    }
+    if area <= 0.0 {
+        return None;
+    }
+    let mean = first / area;
+    let cov = second / area - mean * mean.transpose();
+    let eig = nalgebra::SymmetricEigen::new(cov);
+    let k = eig.eigenvalues.imax();
+    Some(eig.eigenvectors.column(k).into_owned())
+}
+
+/// The pin pair as the two largest bores by wall area of the largest family, for a part whose
+/// long extent tells nothing ([`pair_at_the_ends`] found no pair): refused when another family's
+/// pair or a third bore of the family is of comparable size.
+fn pair_by_wall_area<'a>(
+    families: &[Vec<&'a Bore>],
+    seen: &str,
+) -> Result<(&'a Bore, &'a Bore), PinSearchError> {
+    let pair_area = |f: &Vec<&Bore>| f[0].area + f[1].area;
+    let mut pairs: Vec<&Vec<&Bore>> = families.iter().filter(|f| f.len() >= 2).collect();
+    pairs.sort_by(|a, b| pair_area(b).total_cmp(&pair_area(a)));
+    if pairs.len() > 1 && pair_area(pairs[1]) >= COMPARABLE_AREA * pair_area(pairs[0]) {
+        return Err(PinSearchError::NotParallel(seen.to_string()));
+    }
+    let family = pairs[0];
+    let competitors = family[2..]
+        .iter()
+        .filter(|b| b.area >= COMPARABLE_AREA * family[1].area)
+        .count();
+    if competitors > 0 {
+        return Err(PinSearchError::Ambiguous {
+            count: competitors + 2,
+            list: seen.to_string(),
+        });
+    }
+    Ok((family[0], family[1]))
 }

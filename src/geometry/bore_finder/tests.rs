@@ -258,7 +258,7 @@ fn capless_big_end_is_an_arc_of_180_degrees() {
 }
 
 #[test]
-fn equal_radii_and_three_holes_are_refused() {
+fn equal_radii_are_refused_and_three_holes_give_the_ends() {
     let h = |x, r| Hole { x, r, half: false };
     let m = as_read(&rod(&[h(0.0, 20.0), h(180.0, 20.1)]));
     let e = find_pins(&m, None, Units::Mm).unwrap_err();
@@ -267,12 +267,12 @@ fn equal_radii_and_three_holes_are_refused() {
             .contains("cannot tell the crank end from the piston end"),
         "{e}"
     );
+    // three holes in line: the pins are the two at the ends of the part's long extent
     let m = as_read(&rod(&[h(0.0, 24.0), h(120.0, 16.0), h(240.0, 12.0)]));
-    let e = find_pins(&m, None, Units::Mm).unwrap_err();
-    assert!(
-        matches!(e, PinSearchError::Ambiguous { count: 3, .. }),
-        "{e}"
-    );
+    let f = find_pins(&m, None, Units::Mm).unwrap();
+    assert!(close(f.crank.centre, Vector3::zeros(), 1e-5));
+    assert!(close(f.piston.centre, Vector3::new(0.24, 0.0, 0.0), 1e-5));
+    assert!((f.crank.radius - 0.024).abs() < 1e-8);
     // a small oil hole does not compete
     let m = as_read(&rod(&[h(0.0, 24.0), h(120.0, 2.0), h(240.0, 12.0)]));
     let f = find_pins(&m, None, Units::Mm).unwrap();
