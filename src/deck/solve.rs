@@ -408,15 +408,20 @@ fn solve_step(
         e => e,
     })?;
     let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
-    if !(sol.residual_rel[0].is_finite() && finite(&sol.displacements[0])) {
+    // a solution beyond f64's range is the data's (loads, constants, coordinates out of any
+    // physical range), never the supports'
+    let overflow = |what: &str| {
         let largest = problem.loads[0].iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        return Err(FemError::InvalidInput(format!(
-            "step {number} (line {}): the solution overflows f64 (non-finite displacements or \
-             residual; largest nodal load {largest:.3e}): the loads, the material constants or \
-             the node coordinates are out of range: check their values and units (*CLOAD, \
-             *DLOAD, *ELASTIC, *NODE)",
+        FemError::InvalidInput(format!(
+            "step {number} (line {}): the solution overflows f64 (non-finite {what}; largest \
+             nodal load {largest:.3e}): the loads, the material constants or the node \
+             coordinates are out of range: check their values and units (*CLOAD, *DLOAD, \
+             *ELASTIC, *NODE)",
             step.line
-        )));
+        ))
+    };
+    if !(sol.residual_rel[0].is_finite() && finite(&sol.displacements[0])) {
+        return Err(overflow("displacements or residual"));
     }
     if sol.residual_rel[0] > MAX_RESIDUAL_REL {
         return Err(FemError::InvalidInput(format!(
@@ -429,6 +434,9 @@ fn solve_step(
     let ts = Instant::now();
     let u = &sol.displacements[0];
     let stress = calculix_nodal_stress(mesh, &material, u, options.extrapolation)?;
+    if !finite(stress.nodal.as_flattened()) {
+        return Err(overflow("stresses"));
+    }
     let mut timings = sol.timings;
     timings.stress_s = ts.elapsed().as_secs_f64();
     // an added midside node's reaction goes half to each corner of its edge (the constraint
