@@ -359,7 +359,7 @@ fn driven(args: DrivenArgs) -> Result<i32> {
         ..defaults
     };
     // the flags within the settings' ranges, checked once (not per design)
-    if !(scene.omega_rad_s <= crate::config::MAX_OMEGA_RAD_S) {
+    if scene.omega_rad_s > crate::config::MAX_OMEGA_RAD_S {
         anyhow::bail!(
             "--omega {:e} is out of range: it must be at most {:e} rad/s (20 000 rpm is 2094 rad/s)",
             scene.omega_rad_s,
