@@ -44,7 +44,7 @@ impl<'de> Deserialize<'de> for TracePath {
     }
 }
 
-/// The engine around the rod (SPEC "The engine", issue 20): crank, piston and the cylinder
+/// The engine around the rod (SPEC "The engine"): crank, piston and the cylinder
 /// pressure. Defaults: the thesis' test rig (SPEC "The mechanism") without gas force, so that
 /// every default result stays as it is; the default is not written into `results.json`.
 ///
