@@ -9,6 +9,8 @@ use rodstudy::geometry::primitives::{ascii_stl, binary_stl, to_soup, voxel_rod};
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
 
+mod common;
+
 fn rodstudy(args: &[&str], env: &[(&str, &str)]) -> Output {
     let mut c = Command::new(env!("CARGO_BIN_EXE_rodstudy"));
     c.args(args);
@@ -219,23 +221,9 @@ fn a_step_reader_past_the_time_limit_fails_its_design_alone() {
     assert!(stderr.contains("stopped after 1 s"), "{stderr}");
 }
 
-/// A box written by gmsh (OpenCASCADE) as STEP: the text and (entity, 1-based line) of its first
-/// `CARTESIAN_POINT`.
+/// The box of [`common::box_step`] and (entity, 1-based line) of its first `CARTESIAN_POINT`.
 fn box_step(dir: &Path) -> (String, String, usize) {
-    let path = dir.join("box.step");
-    let script = format!(
-        "import gmsh\ngmsh.initialize(readConfigFiles=False)\ngmsh.option.setNumber('General.Verbosity', 1)\n\
-         gmsh.model.occ.addBox(0, 0, 0, 100, 40, 20)\ngmsh.model.occ.synchronize()\n\
-         gmsh.write({:?})\ngmsh.finalize()\n",
-        path.to_str().unwrap()
-    );
-    let o = Command::new(rodstudy::python_env::python().unwrap())
-        .args(["-c", &script])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let text = std::fs::read_to_string(&path).unwrap();
-    std::fs::remove_file(&path).unwrap();
+    let text = common::box_step(dir);
     let (i, line) = text
         .lines()
         .enumerate()

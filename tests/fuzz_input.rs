@@ -433,25 +433,8 @@ piston_pin = [180.0, 0.0, 0.0]\npin_axis = [0.0, 0.0, 1.0]\n";
     }
 }
 
-/// A box written by gmsh as STEP.
-fn box_step(dir: &Path) -> Vec<u8> {
-    let path = dir.join("box.step");
-    let script = format!(
-        "import gmsh\ngmsh.initialize(readConfigFiles=False)\ngmsh.option.setNumber('General.Verbosity', 1)\n\
-         gmsh.model.occ.addBox(0, 0, 0, 100, 40, 20)\ngmsh.model.occ.synchronize()\n\
-         gmsh.write({:?})\ngmsh.finalize()\n",
-        path.to_str().unwrap()
-    );
-    let o = Command::new(rodstudy::python_env::python().unwrap())
-        .args(["-c", &script])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    std::fs::read(&path).unwrap()
-}
-
 fn fuzz_steps(rng: &mut Rng, dir: &Path, tally: &mut Tally) {
-    let base = box_step(dir);
+    let base = common::box_step(dir).into_bytes();
     for case in 0..STEP_CASES {
         let (bytes, how) = mutated(rng, &base);
         let file: PathBuf = dir.join(format!("fuzz{case}.step"));

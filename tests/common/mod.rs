@@ -1,5 +1,5 @@
 //! Helpers shared by the end-to-end tests: copying a design, the one crank–slider rig built
-//! directly on the multibody core, and a small C3D10 deck.
+//! directly on the multibody core, a small C3D10 deck and a STEP box.
 // each test binary uses only some of them
 #![allow(dead_code)]
 
@@ -105,4 +105,24 @@ pub fn cube_deck(material: &str, load: &str) -> (String, usize, usize) {
     s += load;
     s += "*NODE PRINT, NSET=ALL\nU\n*END STEP\n";
     (s, elastic, first_element)
+}
+
+/// A box 100 × 40 × 20 mm written by gmsh (OpenCASCADE) as STEP, as text (the file in `dir` is
+/// removed again).
+pub fn box_step(dir: &Path) -> String {
+    let path = dir.join("box.step");
+    let script = format!(
+        "import gmsh\ngmsh.initialize(readConfigFiles=False)\ngmsh.option.setNumber('General.Verbosity', 1)\n\
+         gmsh.model.occ.addBox(0, 0, 0, 100, 40, 20)\ngmsh.model.occ.synchronize()\n\
+         gmsh.write({:?})\ngmsh.finalize()\n",
+        path.to_str().unwrap()
+    );
+    let o = std::process::Command::new(rodstudy::python_env::python().unwrap())
+        .args(["-c", &script])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(&path).unwrap();
+    std::fs::remove_file(&path).unwrap();
+    text
 }
