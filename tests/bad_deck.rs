@@ -1,6 +1,7 @@
 //! What `rodstudy solve` refuses in a deck, by file and line, and what it reads: physically
 //! impossible material data (E ≤ 0, ν outside (−1, 0.5), a negative density), a data line without
-//! data, a node listed twice by one element (named by the deck's element id), a load beyond any
+//! data, a node listed twice by one element (named by the deck's element id), coordinates beyond
+//! any model and corners at one place, a load beyond any
 //! physical one (where the solution's norms leave f64) and a solution that overflows all the
 //! same (never blamed on the supports); a UTF-8 byte-order mark and a Latin-1 byte in a comment
 //! are read; a closed standard output ends `solve --json` quietly.
@@ -109,6 +110,53 @@ fn malformed_data_lines_are_refused_with_their_line() {
     let e = refusal(&(lines.join("\n") + "\n"));
     let want = format!("cube.inp:{first}: element 1 lists node {} twice", fields[1]);
     assert!(e.contains(&want), "«{want}» in «{e}»");
+}
+
+/// Coordinates no model has, and an element whose corners sit at one place (1e-300 apart: the
+/// distance underflows), named by line and the deck's ids.
+#[test]
+fn absurd_coordinates_and_coinciding_corners_are_refused_with_their_line() {
+    let (text, _, first) = cube(STEEL, PULL);
+    let node_line = |id: usize| {
+        text.lines()
+            .position(|l| l.starts_with(&format!("{id}, ")))
+            .unwrap()
+    };
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let k = node_line(2);
+    lines[k] = "2, 1e300, 0.0, 0.0".into();
+    let e = refusal(&(lines.join("\n") + "\n"));
+    assert!(
+        e.contains(&format!("cube.inp:{}: x 1e300 is beyond any model", k + 1)),
+        "{e}"
+    );
+    // element 1's first two corners moved to 1e-300 apart
+    let element: Vec<String> = text
+        .lines()
+        .nth(first - 1)
+        .unwrap()
+        .split(", ")
+        .map(String::from)
+        .collect();
+    let (a, b) = (
+        element[1].parse::<usize>().unwrap(),
+        element[2].parse::<usize>().unwrap(),
+    );
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let pa: Vec<String> = lines[node_line(a)].split(", ").map(String::from).collect();
+    lines[node_line(b)] = format!(
+        "{b}, {}, {}, {}",
+        pa[1],
+        pa[2],
+        pa[3].parse::<f64>().unwrap() + 1e-300
+    );
+    let e = refusal(&(lines.join("\n") + "\n"));
+    assert!(
+        e.contains(&format!(
+            "cube.inp:{first}: element 1: its corners 1 and 2 (nodes {a} and {b}) coincide"
+        )),
+        "{e}"
+    );
 }
 
 #[test]

@@ -173,6 +173,26 @@ pub(super) fn load(path: &Path, d: &DataLine, k: usize, what: &str) -> Result<f6
     Ok(v)
 }
 
+/// Largest magnitude of a node coordinate: beyond any model in any units (1e12 mm is a million
+/// kilometres), where the elements' stiffness leaves f64's precision.
+pub const MAX_COORDINATE: f64 = 1e12;
+
+/// Field `k` of `d` as a node coordinate: finite and at most [`MAX_COORDINATE`] in magnitude.
+pub(super) fn coordinate(path: &Path, d: &DataLine, k: usize, what: &str) -> Result<f64> {
+    let v = num(path, d, k, what)?;
+    if v.abs() > MAX_COORDINATE {
+        return Err(error(
+            path,
+            d.line,
+            format!(
+                "{what} {v:e} is beyond any model (|coordinate| ≤ {MAX_COORDINATE:e} in any \
+                 units): check the value and its units"
+            ),
+        ));
+    }
+    Ok(v)
+}
+
 pub(super) fn int(path: &Path, line: usize, f: &str, what: &str) -> Result<i64> {
     f.parse()
         .map_err(|_| error(path, line, format!("{what}: '{f}' is not an integer")))
