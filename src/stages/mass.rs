@@ -35,10 +35,11 @@ pub fn load(file: &Path) -> Result<LoadedDesign> {
             );
             Ok(d)
         }
-        Err(stl_error) => Err(step_error.context(format!(
-            "the STL beside it fails too ({})",
+        Err(stl_error) => Err(anyhow::anyhow!(
+            "{}; the STL beside it fails too: {}",
+            one_line(&step_error),
             one_line(&stl_error)
-        ))),
+        )),
     }
 }
 
