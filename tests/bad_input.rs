@@ -353,6 +353,7 @@ fn settings_and_trace_rows_out_of_range_are_refused_up_front() {
         ("[cycle]\ninstants = 1000000000000\n", "`cycle.instants`"),
         ("[driven]\nomega_rad_s = 1e200\n", "`driven.omega_rad_s`"),
         ("[fem]\nmesh_size_mm = 1e300\n", "`fem.mesh_size_mm`"),
+        ("[fem]\nmin_size_mm = 1e-300\n", "`fem.min_size_mm`"),
         (
             "[engine]\npiston_mass_kg = 1e30\n",
             "`engine.piston_mass_kg`",
@@ -360,7 +361,10 @@ fn settings_and_trace_rows_out_of_range_are_refused_up_front() {
     ] {
         let e = read("rodstudy.toml", text.as_bytes()).unwrap_err();
         assert!(e.contains("rodstudy.toml") && e.contains(key), "{key}: {e}");
-        assert!(e.contains("at most") || e.contains("between"), "{e}");
+        assert!(
+            e.contains("at most") || e.contains("at least") || e.contains("between"),
+            "{e}"
+        );
     }
     let trace = "crank_angle_deg,pressure_bar\n0,1\n360,1e300\n720,1\n";
     std::fs::write(dir.path().join("trace.csv"), trace).unwrap();

@@ -301,6 +301,8 @@ pub const MAX_STRENGTH_MPA: f64 = 1e5;
 pub const MAX_FACTOR: f64 = 1e3;
 /// Largest mass (kg) or inertia (kg·m²) of the engine's parts.
 pub const MAX_MASS_KG: f64 = 1e6;
+/// Smallest element size setting, mm (10 µm).
+pub const MIN_MESH_SIZE_MM: f64 = 0.01;
 /// Most cycle instants (0.01° apart over a revolution).
 pub const MAX_INSTANTS: usize = 36_000;
 
@@ -456,6 +458,20 @@ impl StudyConfig {
                 "",
             ),
         ])?;
+        for (key, v) in [
+            ("fem.mesh_size_mm", self.fem.mesh_size_mm),
+            ("fem.initial_size_mm", self.fem.initial_size_mm),
+            ("fem.max_size_mm", self.fem.max_size_mm),
+            ("fem.min_size_mm", self.fem.min_size_mm),
+            ("fem.step_min_size_mm", self.fem.step_min_size_mm),
+        ] {
+            if v < MIN_MESH_SIZE_MM {
+                bail!(
+                    "`{key}` = {v:e} is out of range: it must be at least {MIN_MESH_SIZE_MM} mm \
+                     (finer elements resolve nothing of a rod and take gmsh beyond its time limit)"
+                );
+            }
+        }
         let e = self.fem.youngs_modulus_pa;
         if !(1e9..=1e12).contains(&e) {
             bail!(
