@@ -132,16 +132,18 @@ def bolted_capless(out: pathlib.Path) -> dict:
 
 
 def metres(out: pathlib.Path) -> dict:
-    volumes, _ = fr.build("plain")
-    exact_mm = fr.exact_properties(volumes)
-    gmsh.model.occ.dilate([(3, v) for v in volumes], 0, 0, 0, 1e-3, 1e-3, 1e-3)
-    gmsh.model.occ.synchronize()
+    """The plain rod drawn in metres (every dimension of `foreign_rods.build("plain")` times 1e-3;
+    not a dilation, which OpenCASCADE does by turning every surface into an approximating B-spline)
+    and written by gmsh, whose STEP header declares millimetres."""
+    gmsh.model.add("metres")
+    v = fr.rod_body(*(k * 1e-3 for k in (180, 25, 12.5, 45, 24, 40, 16, 11, 16, 8)), 0)
+    exact_m = fr.exact_properties([v])
     step = write_step(out, "metres")
     assert "SI_UNIT(.MILLI.,.METRE.)" in step.read_text()
     (out / "metres.toml").write_text('units = "m"\n')
     return {"files": ["metres.step"], "crank_pin": [0, 0, 0], "piston_pin": [0.18, 0, 0],
             "crank_bore_radius": 0.025, "piston_bore_radius": 0.0125, "pin_axis": [0, 0, 1],
-            "units": "m", "volume_mm3": exact_mm["volume"],
+            "units": "m", "volume_mm3": exact_m["volume"] * 1e9,
             "expect": "ranked with the sidecar's units = \"m\" (the header says mm); refused "
                       "without it, the message saying to set units"}
 

@@ -210,11 +210,22 @@ fn units_and_pin_mistakes_are_explained() {
         e.contains("piston pin (B)") && e.contains("inside material"),
         "{e}"
     );
-    // A crank pin beside the rod (in air, but not in a bore).
+    // A crank pin beside the rod (in air, outside the part's bounding box).
     write(
         d,
         "pins.toml",
         b"crank_pin = [0.0, 300.0, 0.0]\npiston_pin = [180.0, 300.0, 0.0]\n",
+    );
+    let e = error_of(&rod);
+    assert!(
+        e.contains("crank pin (A) at (0.000, 300.000, 0.000) mm lies outside the part"),
+        "{e}"
+    );
+    // In air within the bounding box, beside the shank: not in a bore.
+    write(
+        d,
+        "pins.toml",
+        b"crank_pin = [100.0, 30.0, 0.0]\npiston_pin = [180.0, 0.0, 0.0]\n",
     );
     let e = error_of(&rod);
     assert!(
@@ -292,6 +303,45 @@ fn implausible_mass_is_warned_about() {
         e.contains("metres.stl")
             && e.contains("cannot be a connecting rod's")
             && e.contains("`density`"),
+        "{e}"
+    );
+}
+
+/// Sidecar values that disagree with the geometry: a `pin_axis` 16.7° off the bores of design 1
+/// (they run along z) is refused with the angle (atan 0.3 = 16.70°); pins swapped (A in the
+/// small-end bore) are studied with a warning that says so; four coordinates are refused.
+#[test]
+fn sidecar_values_that_disagree_with_the_bores() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let rod = d.join("rod.stl");
+    std::fs::copy(root.join("designs/design1.stl"), &rod).unwrap();
+    write(
+        d,
+        "rod.toml",
+        b"crank_pin = [0.0, 0.0, 0.0]\npiston_pin = [180.0, 0.0, 0.0]\npin_axis = [0, 0.3, 1]\n",
+    );
+    let e = error_of(&rod);
+    assert!(
+        e.contains("`pin_axis`") && e.contains("16.7° off the axis of the bore"),
+        "{e}"
+    );
+    write(
+        d,
+        "rod.toml",
+        b"crank_pin = [180.0, 0.0, 0.0]\npiston_pin = [0.0, 0.0, 0.0]\npin_axis = \"z\"\n",
+    );
+    let m = mass_of_design(&rod).unwrap();
+    assert!(
+        m.warnings.iter().any(|w| w.contains("pins are swapped")),
+        "{:?}",
+        m.warnings
+    );
+    write(d, "rod.toml", b"crank_pin = [0, 0, 0, 99]\n");
+    let e = error_of(&rod);
+    assert!(
+        e.contains("rod.toml") && e.contains("`crank_pin` must have 3 coordinates"),
         "{e}"
     );
 }

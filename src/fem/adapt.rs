@@ -408,7 +408,15 @@ pub fn adaptive_rod(
         ];
         let governing = peaks[0].max(peaks[1]);
         let targets: [f64; 2] = std::array::from_fn(|c| tau * (governing / peaks[c]).max(1.0));
-        let converged = iteration >= 1 && (0..2).all(|c| estimates[c] <= targets[c]);
+        // a sequence whose last mesh is coarser at the governing peak than the one before has
+        // not shown that it converged there (the smaller case's peak, judged in MPa of the
+        // governing one, may coarsen)
+        let coarsened = |c: usize| {
+            let v = &histories[c].values;
+            peaks[c] >= governing && v.len() >= 2 && v[v.len() - 1].1 > 1.05 * v[v.len() - 2].1
+        };
+        let converged =
+            iteration >= 1 && (0..2).all(|c| estimates[c] <= targets[c] && !coarsened(c));
         let stop = if converged {
             Some(StopReason::Converged)
         } else if last {
@@ -427,22 +435,32 @@ pub fn adaptive_rod(
         } else {
             None
         };
-        // an unconverged peak whose elements cannot get smaller (the floor): stop and say so
+        // an unconverged peak (or one whose mesh coarsened) is refined: its elements get smaller
+        // unless they are at the floor; when every unconverged peak is at its floor, stop and
+        // say so
         let mut stop = stop;
-        if let Some(ns) = &new_sizes {
-            let stuck = (0..2).all(|c| {
-                estimates[c] <= targets[c] || {
-                    let (_, h_now, loc) = *histories[c].values.last().expect("pushed");
-                    let node = nearest_node(&mesh, loc);
-                    ns[node] >= 0.87 * h_now
+        let mut new_sizes = new_sizes;
+        if let Some(ns) = &mut new_sizes {
+            let mut stuck = true;
+            for c in 0..2 {
+                let (_, h_now, loc) = *histories[c].values.last().expect("pushed");
+                let node = nearest_node(&mesh, loc);
+                let floor = floor_at(&mesh, &sol, opts, geometry, node);
+                let unconverged = estimates[c] > targets[c] || coarsened(c);
+                let at_floor = floor >= 0.87 * h_now;
+                stuck &= !unconverged || at_floor;
+                if unconverged && !at_floor && ns[node] >= 0.87 * h_now {
+                    // the indicator does not refine the peak it doubts: refine it anyway
+                    keep_fine_around(&mesh, ns, loc, 2.0 * h_now, (0.7 * h_now).max(floor), |n| {
+                        floor_at(&mesh, &sol, opts, geometry, n)
+                    });
                 }
-            });
+            }
             if stuck && iteration >= 1 {
                 stop = Some(StopReason::SizeFloor);
             }
         }
         // DOF cap on the predicted next mesh
-        let mut new_sizes = new_sizes;
         if let Some(ns) = &mut new_sizes {
             let predicted = predicted_dofs(&mesh, &sizes, ns);
             if predicted > opts.max_dofs as f64 {
@@ -494,6 +512,36 @@ fn mirror_min(sizes: &mut [f64], source: &[usize]) {
             let m = sizes[n].min(sizes[s]);
             sizes[n] = m;
             sizes[s] = m;
+        }
+    }
+}
+
+/// The smallest size refinement may ask for at `node`: the geometry's floor (an STL's facet
+/// spacing), the loop's floor and the band around a singularity (as [`refine_sizes`] floors).
+fn floor_at(
+    mesh: &TetMesh,
+    sol: &RodSolution,
+    opts: &AdaptOptions,
+    geometry: &GeometrySizes<'_>,
+    node: usize,
+) -> f64 {
+    (geometry.floor)(mesh.nodes()[node])
+        .max(opts.min_size_m)
+        .max(sol.singularity_floor_m[node])
+}
+
+/// Caps the sizes of the nodes within `radius` of `centre` at `cap`, never below a node's floor.
+fn keep_fine_around(
+    mesh: &TetMesh,
+    sizes: &mut [f64],
+    centre: [f64; 3],
+    radius: f64,
+    cap: f64,
+    floor: impl Fn(usize) -> f64,
+) {
+    for (n, p) in mesh.nodes().iter().enumerate() {
+        if dist(*p, centre) <= radius && sizes[n] > cap {
+            sizes[n] = cap.max(floor(n)).min(sizes[n]);
         }
     }
 }

@@ -75,6 +75,10 @@ pub struct RodOptions {
     /// face on the plane z = c (m, rod frame); `None`: the whole rod.
     #[serde(default)]
     pub mirror_plane_z_m: Option<f64>,
+    /// The mesh is of an exact geometry (a STEP's B-rep): a sharp edge is sharp in the part, not
+    /// a fillet an export cut into few facets (what the warnings of the edge band say).
+    #[serde(default)]
+    pub exact_geometry: bool,
 }
 
 /// Results of one load case. Stresses in MPa, lengths in mm, forces in N.
@@ -688,6 +692,7 @@ pub fn rod_fields(st: RodStatic<'_>, options: &RodOptions) -> Result<RodSolution
                     away_av.value,
                     &options.singular_edges_m,
                     singular_band,
+                    options.exact_geometry,
                 ));
             }
         }
@@ -787,14 +792,22 @@ fn edge_band_warning(
     judged_pa: f64,
     edges: &[[[f64; 3]; 2]],
     band: f64,
+    exact_geometry: bool,
 ) -> String {
     let d = edges
         .iter()
         .map(|s| super::stress::point_segment_distance(hidden.location_m, *s))
         .fold(f64::INFINITY, f64::min);
     let p = hidden.location_m.map(|v| v * 1e3);
+    let advice = if exact_geometry {
+        "the edge is sharp in the B-rep, where the stress has no finite peak; if the real part \
+         rounds it, model the fillet in CAD and the peak is there"
+    } else {
+        "if that edge is rounded in the real part (a fillet the export cut into few facets), the \
+         peak is there (a STEP export settles it)"
+    };
     format!(
-        "{}: the {:.1} mm band around the sharp re-entrant edges holds the highest stress of its neighbourhood, {:.1} MPa at ({:.1}, {:.1}, {:.1}) mm, {:.2} mm from the nearest edge, {:.0} % above the judged peak {:.1} MPa: left out as a singularity; if that edge is rounded in the real part (a fillet the export cut into few facets), the peak is there (a STEP export settles it)",
+        "{}: the {:.1} mm band around the sharp re-entrant edges holds the highest stress of its neighbourhood, {:.1} MPa at ({:.1}, {:.1}, {:.1}) mm, {:.2} mm from the nearest edge, {:.0} % above the judged peak {:.1} MPa: left out as a singularity; {advice}",
         if name == "fx" { "F_x" } else { "F_y" },
         band * 1e3,
         hidden.value * 1e-6,

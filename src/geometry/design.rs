@@ -92,6 +92,8 @@ pub struct LoadedDesign {
     pub warnings: Vec<String>,
     /// Vertices merged by the tolerant weld (0 when equality by value closed the surface).
     pub vertices_merged: usize,
+    /// Bodies that do not touch: the gap between the nearest two groups [m] (a lower bound).
+    pub loose_gap_m: Option<f64>,
 }
 
 /// The kind of design file.
@@ -285,6 +287,8 @@ pub fn load_design(stl: &Path) -> Result<LoadedDesign> {
     };
     let (valid, vertices_merged) = validate_welded(weld(&soup), &format).with_context(file)?;
     warnings.extend(valid.warnings);
+    let loose_gap = valid.loose_gap;
+    let mesh_scale = format.step().map_or(scale, |r| r.metres_per_unit);
     let (mesh, mass) = match format.step() {
         Some(report) => (
             valid.mesh.scaled(report.metres_per_unit),
@@ -330,6 +334,7 @@ pub fn load_design(stl: &Path) -> Result<LoadedDesign> {
         pins,
         warnings,
         vertices_merged,
+        loose_gap_m: loose_gap.map(|g| g * mesh_scale),
     })
 }
 
@@ -519,6 +524,17 @@ fn rod_record(d: &LoadedDesign, stl: &Path) -> Result<DesignMass> {
         (r, _) => r?,
     };
     let piston = pin_bore(d, &surface, Pin::Piston, &bores, &mut warnings).with_context(file)?;
+    if d.pins.source == PinsSource::Sidecar && crank.radius < 0.95 * piston.radius {
+        let mm = 1.0 / d.settings.units.to_metres();
+        let u = d.settings.units.symbol();
+        warnings.push(format!(
+            "the sidecar's crank pin (A) sits in the smaller bore (radius {:.3} {u}) and its \
+             piston pin (B) in the larger ({:.3} {u}): a rod's big end is at the crank; if the \
+             pins are swapped, exchange `crank_pin` and `piston_pin` (l1 is measured from A)",
+            crank.radius * mm,
+            piston.radius * mm
+        ));
+    }
     let rod = RodInFrame::new(&d.frame, &d.mass);
     if !(rod.l1_m > 0.0 && rod.l1_m < rod.centre_distance_m) {
         bail!(
@@ -567,6 +583,9 @@ fn pin_bore(
         Pin::Crank => ("crank pin (A)", d.pins.crank_m, "big end", "A"),
         Pin::Piston => ("piston pin (B)", d.pins.piston_m, "small end", "B"),
     };
+    if d.pins.source == PinsSource::Sidecar {
+        sidecar_pin_in_the_part(d, name, centre)?;
+    }
     let found = d.pins.found.as_ref().map(|f| match pin {
         Pin::Crank => &f.crank,
         Pin::Piston => &f.piston,
@@ -633,6 +652,42 @@ fn pin_bore(
     }
 }
 
+/// A sidecar's pin must lie within the part's bounding box (grown by 1 % of its diagonal): a pin
+/// outside it sits in no bore, whatever the rays from it meet.
+fn sidecar_pin_in_the_part(d: &LoadedDesign, name: &str, centre: Vector3<f64>) -> Result<()> {
+    let (lo, hi) = d.mesh.bounding_box();
+    let margin = 0.01 * (hi - lo).norm();
+    let outside = (0..3)
+        .map(|k| {
+            (lo[k] - margin - centre[k])
+                .max(centre[k] - hi[k] - margin)
+                .max(0.0)
+        })
+        .fold(0.0f64, f64::max);
+    if outside == 0.0 {
+        return Ok(());
+    }
+    let s = 1.0 / d.settings.units.to_metres();
+    let u = d.settings.units.symbol();
+    let (c, lo, hi) = (centre * s, lo * s, hi * s);
+    bail!(
+        "the sidecar's {name} at ({:.3}, {:.3}, {:.3}) {u} lies outside the part (its bounding box \
+         spans ({:.3}, {:.3}, {:.3}) – ({:.3}, {:.3}, {:.3}) {u}, {:.3} {u} beyond it): correct \
+         the pin centre in the sidecar (in the file's units, {u}), or leave the pins out to have \
+         them found from the geometry",
+        c.x,
+        c.y,
+        c.z,
+        lo.x,
+        lo.y,
+        lo.z,
+        hi.x,
+        hi.y,
+        hi.z,
+        outside * s
+    )
+}
+
 /// A sidecar's pin must sit on the axis of the bore around it: the bore the geometry shows
 /// there (found as the pin search finds bores; within the bore's radius of the pin, its axis
 /// parallel) may lie 1 % of its radius from the pin unremarked, up to 5 % with a warning (a pin
@@ -649,6 +704,35 @@ fn pin_on_the_bores_axis(
 ) -> Result<()> {
     let scale = d.settings.units.to_metres();
     let units = d.settings.units.symbol();
+    // the bore around the pin runs along another axis than the sidecar's `pin_axis`
+    let around = bores
+        .iter()
+        .filter(|b| b.full && b.distance_from_axis(centre) < 0.05 * b.radius)
+        .filter(|b| (centre - b.centre_v()).dot(&b.axis_v()).abs() <= 0.5 * b.length)
+        .min_by(|a, b| {
+            a.distance_from_axis(centre)
+                .total_cmp(&b.distance_from_axis(centre))
+        });
+    if let Some(b) = around
+        && d.settings.pin_axis.is_some()
+    {
+        let tilt = b.axis_v().dot(&axis).abs().min(1.0).acos().to_degrees();
+        if tilt > 1.0 {
+            let a = b.axis;
+            bail!(
+                "the sidecar's `pin_axis` ({:.4}, {:.4}, {:.4}) is {tilt:.1}° off the axis of the \
+                 bore around the {name} ({:.4}, {:.4}, {:.4}): the inertia about the pin axis and \
+                 the loads' plane would be those of a tilted pin; correct `pin_axis` (or leave it \
+                 out to have it found from the bores)",
+                axis.x,
+                axis.y,
+                axis.z,
+                a[0],
+                a[1],
+                a[2]
+            );
+        }
+    }
     let near = bores
         .iter()
         .filter(|b| b.full && b.axis_v().dot(&axis).abs() > 1f64.to_radians().cos())

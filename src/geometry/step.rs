@@ -134,7 +134,7 @@ impl StepReport {
                 format!("STEP: {n} solids fused into one bonded body, exact B-rep mass properties")
             }
             (n, v) => format!(
-                "STEP: {n} solids, {v} separate bodies after fusing those that touch (treated as one rigid part), exact B-rep mass properties"
+                "STEP: {n} solids, {v} separate bodies after fusing those that touch, exact B-rep mass properties (their sum)"
             ),
         }
     }

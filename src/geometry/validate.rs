@@ -31,6 +31,9 @@ pub struct ValidMesh {
     pub mesh: IndexedMesh,
     /// Human-readable notes, e.g. that the orientation was flipped.
     pub warnings: Vec<String>,
+    /// Several bodies of which some do not touch the others: the gap between the nearest two
+    /// groups (a lower bound: the distance of their bounding boxes), in the mesh's units.
+    pub loose_gap: Option<f64>,
 }
 
 /// Sine of the smallest angle below which a triangle counts as degenerate (collinear corners).
@@ -52,8 +55,11 @@ pub fn validate(mut mesh: IndexedMesh) -> Result<ValidMesh, MeshError> {
     let mut warnings = Vec::new();
     let (lo, hi) = mesh.bounding_box();
     let box_volume: f64 = (0..3).map(|k| hi[k] - lo[k]).product();
+    let mut loose_gap = None;
     if let Some(roots) = shells {
-        warnings.push(check_shells(&mesh, &roots, box_volume)?);
+        let (note, gap) = check_shells(&mesh, &roots, box_volume)?;
+        warnings.push(note);
+        loose_gap = gap;
     }
     if volume.is_nan() || volume.abs() <= 1e-12 * box_volume {
         return Err(MeshError::ZeroVolume { volume });
@@ -64,7 +70,11 @@ pub fn validate(mut mesh: IndexedMesh) -> Result<ValidMesh, MeshError> {
             "all triangles faced inward (negative volume); the orientation was flipped".into(),
         );
     }
-    Ok(ValidMesh { mesh, warnings })
+    Ok(ValidMesh {
+        mesh,
+        warnings,
+        loose_gap,
+    })
 }
 
 /// Refuses degenerate triangles; returns the signed volume (that of
@@ -344,7 +354,11 @@ fn shells(mesh: &IndexedMesh, pairs: &[u32]) -> Option<Vec<u32>> {
 
 /// Several shells: each must enclose volume, all with the orientation of most of the volume;
 /// returns the warning that says they are taken as one body.
-fn check_shells(mesh: &IndexedMesh, roots: &[u32], box_volume: f64) -> Result<String, MeshError> {
+fn check_shells(
+    mesh: &IndexedMesh,
+    roots: &[u32],
+    box_volume: f64,
+) -> Result<(String, Option<f64>), MeshError> {
     let (lo, hi) = mesh.bounding_box();
     let reference = (lo + hi) / 2.0;
     let mut distinct: Vec<u32> = roots.to_vec();
@@ -375,10 +389,83 @@ fn check_shells(mesh: &IndexedMesh, roots: &[u32], box_volume: f64) -> Result<St
             });
         }
     }
-    Ok(format!(
-        "{} bodies (shells) in one file: treated as one bonded body (their mass properties add)",
-        distinct.len()
+    let (groups, gap) = touching_groups(mesh, roots, &distinct);
+    if groups == 1 {
+        return Ok((
+            format!(
+                "{} bodies (shells) in one file: treated as one bonded body (their mass properties add)",
+                distinct.len()
+            ),
+            None,
+        ));
+    }
+    Ok((
+        format!(
+            "{} bodies (shells) in one file, in {groups} groups that do not touch (the nearest \
+             two at least {gap:.3} file units apart): their mass properties add, but no load \
+             passes between bodies that do not touch, so stage 3 refuses the free body: join \
+             them in CAD (rod and cap touch at the joint face) or remove the loose one",
+            distinct.len()
+        ),
+        Some(gap),
     ))
+}
+
+/// Groups of shells whose bounding boxes touch or overlap (within 1e-6 of the part's
+/// diagonal), joined transitively, and the distance between the bounding boxes of the nearest
+/// two groups (0 for one group). Shells of rod and cap meeting at the joint face, or a bolt
+/// through its hole, are one group; a body lying apart is another.
+fn touching_groups(mesh: &IndexedMesh, roots: &[u32], distinct: &[u32]) -> (usize, f64) {
+    let n = distinct.len();
+    let mut boxes = vec![
+        (
+            Vector3::repeat(f64::INFINITY),
+            Vector3::repeat(f64::NEG_INFINITY)
+        );
+        n
+    ];
+    for (t, r) in roots.iter().enumerate() {
+        let k = distinct.binary_search(r).expect("a root");
+        for p in mesh.corners(t) {
+            boxes[k] = (boxes[k].0.inf(&p), boxes[k].1.sup(&p));
+        }
+    }
+    let (lo, hi) = mesh.bounding_box();
+    let tolerance = 1e-6 * (hi - lo).norm();
+    let gap = |a: &(Vector3<f64>, Vector3<f64>), b: &(Vector3<f64>, Vector3<f64>)| {
+        (0..3)
+            .map(|k| (a.0[k] - b.1[k]).max(b.0[k] - a.1[k]).max(0.0).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    };
+    let mut group: Vec<usize> = (0..n).collect();
+    loop {
+        let mut changed = false;
+        for i in 0..n {
+            for j in i + 1..n {
+                if group[i] != group[j] && gap(&boxes[i], &boxes[j]) <= tolerance {
+                    let (keep, drop) = (group[i].min(group[j]), group[i].max(group[j]));
+                    group
+                        .iter_mut()
+                        .filter(|g| **g == drop)
+                        .for_each(|g| *g = keep);
+                    changed = true;
+                }
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    let mut ids = group.clone();
+    ids.sort_unstable();
+    ids.dedup();
+    let nearest = (0..n)
+        .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
+        .filter(|&(i, j)| group[i] != group[j])
+        .map(|(i, j)| gap(&boxes[i], &boxes[j]))
+        .fold(f64::INFINITY, f64::min);
+    (ids.len(), if ids.len() > 1 { nearest } else { 0.0 })
 }
 
 #[cfg(test)]

@@ -111,6 +111,16 @@ impl RankRow<'_> {
     }
 }
 
+/// A rod body drawn without its cap (a partial pin bore): its mass, peak force and stresses lack
+/// the cap's, so it is ranked after the complete rods and its status says so.
+pub fn is_rod_body_alone(m: &DesignMass) -> bool {
+    m.pins.crank_bore_arc_deg < 360.0 || m.pins.piston_bore_arc_deg < 360.0
+}
+
+/// What the status of a rod body without its cap adds.
+pub const ROD_BODY_ALONE: &str =
+    "rod body alone, without its cap: mass, force and stresses lack the cap's";
+
 /// The ranking of a study: every design that passed stage 1, in report order.
 pub fn ranking(results: &StudyResults) -> Vec<RankRow<'_>> {
     let front: Vec<String> = super::pareto::pareto(results)
@@ -121,11 +131,14 @@ pub fn ranking(results: &StudyResults) -> Vec<RankRow<'_>> {
     let fails = |d: &DesignResult| d.fem.as_ref().is_some_and(|f| !f.criterion.pass);
     let mut done: Vec<&DesignResult> = results.designs.iter().collect();
     done.sort_by(|a, b| {
-        fails(a).cmp(&fails(b)).then(
-            a.dynamics
-                .peak_pin_force_n
-                .total_cmp(&b.dynamics.peak_pin_force_n),
-        )
+        is_rod_body_alone(&a.mass)
+            .cmp(&is_rod_body_alone(&b.mass))
+            .then(fails(a).cmp(&fails(b)))
+            .then(
+                a.dynamics
+                    .peak_pin_force_n
+                    .total_cmp(&b.dynamics.peak_pin_force_n),
+            )
     });
     let mut partial: Vec<&FailedDesign> =
         results.failed.iter().filter(|f| f.mass.is_some()).collect();
@@ -413,7 +426,12 @@ pub fn cells(r: &RankRow) -> [String; 15] {
         })
     };
     let f = r.fem;
-    let notes: Vec<String> = [r.failing_on(), r.model_validity()]
+    let alone = if is_rod_body_alone(r.mass) {
+        ROD_BODY_ALONE.to_string()
+    } else {
+        String::new()
+    };
+    let notes: Vec<String> = [r.failing_on(), r.model_validity(), alone]
         .into_iter()
         .filter(|s| !s.is_empty())
         .collect();
@@ -503,6 +521,10 @@ pub fn explanation(results: &StudyResults) -> String {
         String::new()
     } + if has_engine_loads(results) {
         " Engine loads (a cylinder pressure trace): the F_x case carries the peak pin force (the firing compression), the F_y case the largest pin force across the rod over the cycle (inertia; the gas force acts along the rod); the peak compression and tension are along A→B at the crank pin, with their crank angles (0 = firing top dead centre)."
+    } else {
+        ""
+    } + if results.designs.iter().any(|d| is_rod_body_alone(&d.mass)) {
+        " A rod body drawn without its cap (a partial pin bore) is ranked after the complete rods: in the engine the cap runs with the rod, so its mass, pin force and stresses lack the cap's and are not comparable with those of a complete rod (give the rod with its cap, as a second body of the same file, to compare it)."
     } else {
         ""
     }

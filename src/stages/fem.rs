@@ -326,6 +326,15 @@ impl Setup {
         keep_system: bool,
     ) -> Result<Self> {
         let context = format!("{}: FEM", design.file.display());
+        if let Some(gap) = design.loose_gap_m {
+            anyhow::bail!(
+                "{context}: the file holds bodies that do not touch (the nearest two at least \
+                 {:.3} mm apart): a body that touches nothing carries no load and has no static \
+                 solution; join them in CAD (rod and cap meet at the joint face) or remove the \
+                 loose body",
+                gap * 1e3
+            );
+        }
         let fy_force_n = engine_loads(design, config)
             .with_context(|| context.clone())?
             .and_then(|d| d.peak_transverse_n);
@@ -340,6 +349,7 @@ impl Setup {
             fixed_band_m: Some(config.fem.fixed_band_mm * 1e-3),
             singular_band_m: Some(config.fem.singular_band_mm * 1e-3),
             fy_force_n,
+            exact_geometry: design.format.step().is_some(),
             // the STL route keeps the last solve's system: the geometry check reuses its symbolic
             // analysis
             keep_system: keep_system || (for_gmsh && design.format.step().is_none()),
