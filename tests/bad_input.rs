@@ -122,9 +122,9 @@ fn each_bad_design_is_reported_and_the_good_one_studied() {
     assert!(by_id("good").is_some(), "{designs:#?}");
     let two = by_id("two_shells").expect("two_shells.stl studied");
     assert!(
-        two["mass"]["warnings"]
-            .to_string()
-            .contains("2 groups that do not touch (the nearest two at least 320.000 file units apart)"),
+        two["mass"]["warnings"].to_string().contains(
+            "2 groups that do not touch (the nearest two at least 320.000 file units apart)"
+        ),
         "{}",
         two["mass"]["warnings"]
     );
