@@ -49,6 +49,30 @@ TRI_PTS = np.array([[TA, TA], [1 - 2 * TA, TA], [TA, 1 - 2 * TA], [TB, TB], [1 -
 TRI_W = np.array([TWA] * 3 + [TWB] * 3)
 
 
+def ccx_time_limit() -> float:
+    """The time limit of one ccx run, s: the pipeline's (RODSTUDY_MESHER_TIMEOUT_S, default 600),
+    a little less, so that ccx is stopped here with a message before the caller stops this script."""
+    try:
+        limit = float(os.environ.get("RODSTUDY_MESHER_TIMEOUT_S", "600"))
+    except ValueError:
+        limit = 600.0
+    if not (limit > 0 and limit < float("inf")):
+        limit = 600.0
+    return limit - max(3.0, 0.05 * limit)
+
+
+def run_ccx(ccx: str, work: pathlib.Path, env: dict):
+    """`ccx -i rod` in `work` under the time limit; None (with a message) when it ran out."""
+    limit = ccx_time_limit()
+    try:
+        return subprocess.run([ccx, "-i", "rod"], cwd=work, env=env, capture_output=True, text=True,
+                              timeout=limit)
+    except subprocess.TimeoutExpired:
+        print(f"ccx stopped after {limit:.0f} s (the limit; set RODSTUDY_MESHER_TIMEOUT_S to change it)",
+              file=sys.stderr)
+        return None
+
+
 def read_rodmesh(path: pathlib.Path):
     lines = [l.strip() for l in path.read_text().splitlines() if l.strip() and not l.startswith("#")]
     assert lines[0] == "rodmesh 1", "not a .rodmesh file"
@@ -238,8 +262,10 @@ def main(argv=None) -> int:
     env.setdefault("OMP_NUM_THREADS", "2")
     env.setdefault("CCX_NPROC_EQUATION_SOLVER", env["OMP_NUM_THREADS"])
     t0 = time.perf_counter()
-    run = subprocess.run([ccx, "-i", "rod"], cwd=work, env=env, capture_output=True, text=True)
+    run = run_ccx(ccx, work, env)
     wall = time.perf_counter() - t0
+    if run is None:
+        return 1
     if run.returncode != 0 or not (work / "rod.frd").exists():
         print(run.stdout[-3000:], run.stderr[-3000:], file=sys.stderr)
         return 1
@@ -291,8 +317,10 @@ def buckle(args, ccx, pts, tets, bore_a, bore_b, ra, rb, fixed) -> int:
     env.setdefault("OMP_NUM_THREADS", "2")
     env.setdefault("CCX_NPROC_EQUATION_SOLVER", env["OMP_NUM_THREADS"])
     t0 = time.perf_counter()
-    run = subprocess.run([ccx, "-i", "rod"], cwd=work, env=env, capture_output=True, text=True)
+    run = run_ccx(ccx, work, env)
     wall = time.perf_counter() - t0
+    if run is None:
+        return 1
     factors = read_buckling_factors(work / "rod.dat") if (work / "rod.dat").exists() else []
     if run.returncode != 0 or not factors:
         print(run.stdout[-3000:], run.stderr[-3000:], file=sys.stderr)

@@ -133,7 +133,8 @@ def cmd_read(args) -> dict:
     try:
         entities = gmsh.model.occ.importShapes(str(path))
     except Exception as e:  # gmsh raises a bare Exception with its last error
-        fail(f"{path}: cannot read this STEP file: {e}")
+        fail(f"{path}: cannot read this STEP file ({e}): the file is not valid STEP (a syntax error "
+             "or a cut-off export); export the part again from CAD")
     gmsh.model.occ.synchronize()
     solids = [t for d, t in entities if d == 3]
     if not solids:
@@ -196,7 +197,12 @@ def main(argv=None) -> int:
     r.add_argument("out", help="the surface triangulation (binary STL, file units)")
     r.add_argument("--fine", action="store_true", help="360 instead of 150 elements per turn of curvature")
     args = ap.parse_args(argv)
-    print(json.dumps(cmd_read(args)))
+    try:
+        report = cmd_read(args)
+    except Exception as e:  # gmsh's bare Exception, or a triangulation that is not closed
+        fail(f"{args.step}: OpenCASCADE cannot make a solid of this file ({type(e).__name__}: {e}): the "
+             "geometry is malformed; export the part again as STEP, or study its STL instead")
+    print(json.dumps(report))
     return 0
 
 

@@ -6,16 +6,24 @@
 //! of pins reinstalls and everything else reuses it. `RODSTUDY_PYTHON` names an existing
 //! interpreter instead (checked to import the three packages). A file lock serialises concurrent
 //! first uses (parallel tests, several studies).
+//!
+//! A pipeline script reading a malformed file can run for ever (OpenCASCADE on a STEP with an
+//! absurd coordinate, meshio's Nastran reader on a truncated .bdf): [`output_within`] runs a
+//! child under the time limit [`pipeline_timeout`], the one limit of the mesher and the STEP reader.
 
 use anyhow::{Context, Result, bail};
 use std::fs::File;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
 
 /// Environment variable naming an existing Python interpreter to use instead of `.venv`.
 pub const PYTHON_VAR: &str = "RODSTUDY_PYTHON";
 /// Environment variable overriding the project root (where `pipeline/` and `.venv/` live).
 pub const ROOT_VAR: &str = "RODSTUDY_ROOT";
+/// Environment variable: the time limit of a pipeline script (meshing, reading a STEP) in
+/// seconds (default 600).
+pub const TIMEOUT_VAR: &str = "RODSTUDY_MESHER_TIMEOUT_S";
 /// The modules every pipeline script needs.
 const REQUIRED_MODULES: &str = "import gmsh, meshio, numpy";
 
@@ -167,4 +175,76 @@ fn stderr_as_stdout() -> Stdio {
         .try_clone_to_owned()
         .map(Stdio::from)
         .unwrap_or_else(|_| Stdio::null())
+}
+
+/// The time limit of a pipeline script: `RODSTUDY_MESHER_TIMEOUT_S` seconds, else 600.
+pub fn pipeline_timeout() -> Duration {
+    let secs = std::env::var(TIMEOUT_VAR)
+        .ok()
+        .and_then(|v| v.parse::<f64>().ok())
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .unwrap_or(600.0);
+    Duration::from_secs_f64(secs)
+}
+
+/// Runs `command` to completion like `Command::output`, but kills it after `limit` (an error of
+/// kind `TimedOut` that says the limit and [`TIMEOUT_VAR`]). The output goes through temporary
+/// files, so a chatty child never blocks on a full pipe.
+pub fn output_within(
+    command: &mut Command,
+    limit: Duration,
+) -> std::io::Result<std::process::Output> {
+    let stdout = tempfile::tempfile()?;
+    let stderr = tempfile::tempfile()?;
+    let mut child = command
+        .stdout(stdout.try_clone()?)
+        .stderr(stderr.try_clone()?)
+        .spawn()?;
+    let start = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait()? {
+            break status;
+        }
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::TimedOut,
+                format!(
+                    "stopped after {:.0} s (the limit; set {TIMEOUT_VAR} to change it)",
+                    limit.as_secs_f64()
+                ),
+            ));
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let read = |mut f: File| -> std::io::Result<Vec<u8>> {
+        use std::io::{Read, Seek};
+        let mut bytes = Vec::new();
+        f.seek(std::io::SeekFrom::Start(0))?;
+        f.read_to_end(&mut bytes)?;
+        Ok(bytes)
+    };
+    Ok(std::process::Output {
+        status,
+        stdout: read(stdout)?,
+        stderr: read(stderr)?,
+    })
+}
+
+#[cfg(test)]
+mod timeout_tests {
+    use super::*;
+
+    #[test]
+    fn a_hanging_child_is_stopped_with_a_clear_error() {
+        // the TimedOut error is returned only after the child was killed and reaped (no wall
+        // time is asserted: that belongs to benchmarks)
+        let err =
+            output_within(Command::new("sleep").arg("5"), Duration::from_millis(200)).unwrap_err();
+        assert_eq!(err.kind(), std::io::ErrorKind::TimedOut);
+        assert!(err.to_string().contains(TIMEOUT_VAR));
+        let ok = output_within(Command::new("echo").arg("hi"), Duration::from_secs(5)).unwrap();
+        assert_eq!(ok.stdout, b"hi\n");
+    }
 }

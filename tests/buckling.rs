@@ -147,12 +147,15 @@ fn design1_against_calculix_buckle() {
     .unwrap();
     let file = dir.path().join("design1_8mm.rodmesh");
     write_rodmesh(&meshed.mesh, &file).unwrap();
-    let out = std::process::Command::new(&py)
-        .arg(root.join("pipeline/ccx_peer.py"))
-        .arg(&file)
-        .args(["--buckle", "--json", "--force", "7500"])
-        .output()
-        .unwrap();
+    // under the pipeline's time limit (ccx_peer.py stops ccx a little before it)
+    let out = rodstudy::python_env::output_within(
+        std::process::Command::new(&py)
+            .arg(root.join("pipeline/ccx_peer.py"))
+            .arg(&file)
+            .args(["--buckle", "--json", "--force", "7500"]),
+        rodstudy::python_env::pipeline_timeout(),
+    )
+    .unwrap();
     assert!(
         out.status.success(),
         "ccx_peer.py --buckle: {}",

@@ -128,13 +128,16 @@ fn run_ccx(deck: &Path) -> Ccx {
     let dir = deck.parent().unwrap();
     let job = deck.file_stem().unwrap().to_str().unwrap();
     let t = Instant::now();
-    let run = Command::new(ccx())
-        .args(["-i", job])
-        .current_dir(dir)
-        .env("OMP_NUM_THREADS", "2")
-        .env("CCX_NPROC_EQUATION_SOLVER", "2")
-        .output()
-        .unwrap();
+    // under a time limit, as the pipeline's children: a ccx that hangs fails the test
+    let run = rodstudy::python_env::output_within(
+        Command::new(ccx())
+            .args(["-i", job])
+            .current_dir(dir)
+            .env("OMP_NUM_THREADS", "2")
+            .env("CCX_NPROC_EQUATION_SOLVER", "2"),
+        std::time::Duration::from_secs(300),
+    )
+    .unwrap_or_else(|e| panic!("ccx on {}: {e}", deck.display()));
     let wall_s = t.elapsed().as_secs_f64();
     assert!(
         run.status.success(),

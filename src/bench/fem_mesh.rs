@@ -409,12 +409,15 @@ fn ccx_run(
     crate::mesher::write_rodmesh(mesh, &rodmesh)?;
     let python = crate::python_env::python()?;
     let peer = |extra: &[&str]| -> Result<serde_json::Value> {
-        let o = Command::new(&python)
-            .arg(crate::python_env::pipeline_script("ccx_peer.py"))
-            .arg(&rodmesh)
-            .args(["--force", &force_n.to_string(), "--json"])
-            .args(extra)
-            .output()?;
+        let o = crate::python_env::output_within(
+            Command::new(&python)
+                .arg(crate::python_env::pipeline_script("ccx_peer.py"))
+                .arg(&rodmesh)
+                .args(["--force", &force_n.to_string(), "--json"])
+                .args(extra),
+            crate::python_env::pipeline_timeout(),
+        )
+        .context("ccx_peer.py")?;
         if !o.status.success() {
             bail!("ccx_peer.py: {}", String::from_utf8_lossy(&o.stderr).trim());
         }

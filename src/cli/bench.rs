@@ -77,18 +77,18 @@ pub fn run(command: BenchCommand) -> Result<i32> {
         } => {
             let b = bench_mass(triangles, repeats)?;
             if json {
-                println!("{}", serde_json::to_string_pretty(&b)?);
+                outln!("{}", serde_json::to_string_pretty(&b)?);
                 return Ok(0);
             }
-            println!(
+            outln!(
                 "mass stage on a torus of {} triangles ({:.1} MB binary STL), median of {} runs:\n",
                 b.triangles,
                 b.file_bytes as f64 / 1e6,
                 b.repeats
             );
-            println!("| step | time [ms] | triangles/s | × read bytes |\n|---|---|---|---|");
+            outln!("| step | time [ms] | triangles/s | × read bytes |\n|---|---|---|---|");
             for s in &b.steps {
-                println!(
+                outln!(
                     "| {} | {:.1} | {:.3e} | {:.1} |",
                     s.step,
                     s.seconds * 1e3,
@@ -96,7 +96,7 @@ pub fn run(command: BenchCommand) -> Result<i32> {
                     s.ratio_to_read_bytes
                 );
             }
-            println!(
+            outln!(
                 "\nvolume vs the smooth torus: {:.2e} relative (tessellation error, O(1/n²))",
                 b.volume_rel_error_vs_smooth_torus
             );
@@ -143,35 +143,36 @@ pub fn run(command: BenchCommand) -> Result<i32> {
             let scene = DrivenScene::default();
             let b = bench_driven(&params, &rod, &scene, repeats)?;
             if json {
-                println!("{}", serde_json::to_string_pretty(&b)?);
+                outln!("{}", serde_json::to_string_pretty(&b)?);
                 return Ok(0);
             }
-            println!(
+            outln!(
                 "driven scene ({} steps, {} samples) for {name}, median of {} runs:\n",
-                b.steps, b.samples, b.repeats
+                b.steps,
+                b.samples,
+                b.repeats
             );
-            println!(
-                "| model | per scene [ms] | per step [µs] | × closed form |\n|---|---|---|---|"
-            );
-            println!(
+            outln!("| model | per scene [ms] | per step [µs] | × closed form |\n|---|---|---|---|");
+            outln!(
                 "| closed-form Newton–Euler | {:.3} | {:.3} | 1.0 |",
                 b.closed_form_scene_s * 1e3,
                 b.closed_form_per_step_s * 1e6
             );
-            println!(
+            outln!(
                 "| multibody core (9 coordinates, Newton–Raphson, multipliers) | {:.3} | {:.3} | {:.1} |",
                 b.multibody_scene_s * 1e3,
                 b.multibody_per_step_s * 1e6,
                 b.ratio_multibody_over_closed_form
             );
-            println!(
+            outln!(
                 "| refined peak only (closed form, one revolution) | {:.4} | — | {:.3} |",
                 b.peak_only_s * 1e3,
                 b.peak_only_s / b.closed_form_scene_s
             );
-            println!(
+            outln!(
                 "\npeak {:.3} N; multibody vs closed form: max relative difference {:.2e}",
-                b.peak_pin_force_n, b.max_rel_diff
+                b.peak_pin_force_n,
+                b.max_rel_diff
             );
             Ok(0)
         }
@@ -200,9 +201,9 @@ fn bench_fem_mesh(
     };
     let b = crate::bench::fem_mesh::bench_fem_mesh(design, mesh, force, repeats, ccx)?;
     if json {
-        println!("{}", serde_json::to_string_pretty(&b)?);
+        outln!("{}", serde_json::to_string_pretty(&b)?);
     } else {
-        print!("{}", crate::bench::fem_mesh::markdown(&b));
+        out!("{}", crate::bench::fem_mesh::markdown(&b));
     }
     Ok(0)
 }
@@ -216,9 +217,9 @@ fn bench_fem_adaptive(designs: Vec<PathBuf>, json: bool) -> Result<i32> {
     };
     let b = crate::bench::fem_adaptive::bench_fem_adaptive(&std::env::current_exe()?, &files)?;
     if json {
-        println!("{}", serde_json::to_string_pretty(&b)?);
+        outln!("{}", serde_json::to_string_pretty(&b)?);
     } else {
-        print!("{}", crate::bench::fem_adaptive::markdown(&b));
+        out!("{}", crate::bench::fem_adaptive::markdown(&b));
     }
     Ok(0)
 }
@@ -256,18 +257,18 @@ fn bench_fem(designs: Vec<PathBuf>, size: f64, force: Option<f64>, json: bool) -
     }
     if json {
         let all: Vec<&serde_json::Value> = rows.iter().map(|r| &r.1).collect();
-        println!("{}", serde_json::to_string_pretty(&all)?);
+        outln!("{}", serde_json::to_string_pretty(&all)?);
         return Ok(0);
     }
-    println!("FEM at {size} mm, each design in its own process\n");
-    println!(
+    outln!("FEM at {size} mm, each design in its own process\n");
+    outln!(
         "| design | DOFs | elements | mesh [s] | assembly [s] | symbolic [s] | factorisation [s] | solve, 2 cases [s] | stress [s] | nnz(L) | peak memory [MB] |\n|---|---|---|---|---|---|---|---|---|---|---|"
     );
     for (stl, v) in &rows {
         let f = &v["fem"];
         let t = &f["timings"];
         let s = |x: &serde_json::Value| x.as_f64().map_or("—".into(), |v| format!("{v:.2}"));
-        println!(
+        outln!(
             "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             stl.file_stem()
                 .map(|s| s.to_string_lossy().into_owned())

@@ -31,9 +31,9 @@ pub fn run(args: CheckArgs) -> Result<i32> {
     let baseline = Baseline::read(&args.baseline)?;
     let rows = check(&baseline, &results, args.rtol, args.rtol_mass);
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&rows)?);
+        outln!("{}", serde_json::to_string_pretty(&rows)?);
     } else {
-        print!("{}", check_table(&rows, args.rtol, args.rtol_mass));
+        out!("{}", check_table(&rows, args.rtol, args.rtol_mass));
     }
     let failing = rows.iter().filter(|r| !r.passed()).count();
     if failing > 0 {

@@ -79,7 +79,7 @@ pub fn run(args: CycleArgs) -> Result<i32> {
     let t = &fem.fem.timings;
     let static_s = t.assembly_s + t.symbolic_s + t.factorisation_s + t.solve_s + t.stress_s;
     if args.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&CycleJson {
                 cycle: &cycle,
@@ -89,7 +89,7 @@ pub fn run(args: CycleArgs) -> Result<i32> {
             })?
         );
     } else {
-        println!(
+        outln!(
             "{}: {} instants over {} at {:.2} rad/s, mesh {} elements / {} DOFs",
             mass.design,
             cycle.instants,
@@ -98,7 +98,7 @@ pub fn run(args: CycleArgs) -> Result<i32> {
             mesh.mesh.n_elements(),
             mesh.mesh.n_dofs()
         );
-        println!(
+        outln!(
             "max von Mises over the cycle (away from the fixed bore): {:.2} MPa at φ = {:.1}°, at ({:.1}, {:.1}, {:.1}) mm",
             cycle.max_von_mises_over_cycle_mpa,
             cycle.crank_angle_of_max_deg,
@@ -106,7 +106,7 @@ pub fn run(args: CycleArgs) -> Result<i32> {
             cycle.location_of_max_mm[1],
             cycle.location_of_max_mm[2]
         );
-        println!(
+        outln!(
             "fatigue ({}, Se {:.0} / Sut {:.0} MPa): safety factor {:.2} at ({:.1}, {:.1}, {:.1}) mm, σa {:.2} MPa, σm {:.2} MPa",
             if cycle.mean_stress.is_goodman() {
                 "Goodman"
@@ -122,14 +122,14 @@ pub fn run(args: CycleArgs) -> Result<i32> {
             cycle.fatigue_alternating_mpa,
             cycle.fatigue_mean_mpa
         );
-        println!(
+        outln!(
             "reaction at B against the dynamics' F_B: largest difference {:.2e} of the peak pin force ({:.1} N); mesh mass {:.4} kg (STL {:.4} kg)",
             cycle.reaction_mismatch_rel,
             cycle.peak_pin_force_n,
             cycle.mesh_mass_kg,
             cycle.stl_mass_kg
         );
-        println!(
+        outln!(
             "time: cycle analysis {:.2} s ({} unit solves, {} instants combined; {:.2} s the whole stage), static two-case analysis of the same mesh {:.2} s: ratio {:.2}",
             cycle.analysis_seconds,
             cycle.cosine_bore_load.as_ref().map_or(6, |c| c.unit_solves),

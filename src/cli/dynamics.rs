@@ -285,14 +285,16 @@ fn free(args: FreeArgs) -> Result<i32> {
         warnings: &run.warnings,
     };
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&summary)?);
+        outln!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
-        println!("scene free, method {} ({})", summary.method, summary.model);
-        println!(
+        outln!("scene free, method {} ({})", summary.method, summary.model);
+        outln!(
             "t_end = {} s: φ = {:.12} rad, ω = {:.12} rad/s",
-            summary.t_end_s, summary.phi_rad, summary.omega_rad_s
+            summary.t_end_s,
+            summary.phi_rad,
+            summary.omega_rad_s
         );
-        println!(
+        outln!(
             "steps {} (+{} rejected), RHS evaluations {}, Jacobians {}, LU {}, time {:.3} ms",
             summary.steps,
             summary.rejected_steps,
@@ -302,23 +304,25 @@ fn free(args: FreeArgs) -> Result<i32> {
             summary.cpu_s * 1e3
         );
         if let (Some(p), Some(w)) = (summary.max_err_phi_rad, summary.max_err_omega_rad_s) {
-            println!(
+            outln!(
                 "against the exact energy-integral reference: max |Δφ| = {p:.3e} rad, max |Δω| = {w:.3e} rad/s"
             );
         }
         if let Some(e) = summary.energy_drift_max_j {
-            println!("energy drift: {e:.3e} J");
+            outln!("energy drift: {e:.3e} J");
         }
         if let Some(p) = &summary.energy_projection {
-            println!(
+            outln!(
                 "energy projection: {} projections, largest change of φ̇ {:.3e} rad/s",
-                p.projections, p.max_change_rad_s
+                p.projections,
+                p.max_change_rad_s
             );
         }
         if let Some(c) = &summary.constraint_drift_max {
-            println!(
+            outln!(
                 "constraint drift: max |Φ| = {:.3e} (m, rad), max |D ċ| = {:.3e} (m/s, rad/s)",
-                c.position, c.velocity
+                c.position,
+                c.velocity
             );
         }
     }
@@ -354,6 +358,15 @@ fn driven(args: DrivenArgs) -> Result<i32> {
         steps: args.steps.unwrap_or(defaults.steps),
         ..defaults
     };
+    // the flags within the settings' ranges, checked once (not per design)
+    if scene.omega_rad_s > crate::config::MAX_OMEGA_RAD_S {
+        anyhow::bail!(
+            "--omega {:e} is out of range: it must be at most {:e} rad/s (20 000 rpm is 2094 rad/s)",
+            scene.omega_rad_s,
+            crate::config::MAX_OMEGA_RAD_S
+        );
+    }
+    scene.validate()?;
     let method = match args.method {
         MethodArg::ClosedForm => Method::ClosedForm,
         MethodArg::Multibody => Method::Multibody,
@@ -374,9 +387,9 @@ fn driven(args: DrivenArgs) -> Result<i32> {
         .filter_map(|o| o.as_ref().ok().map(|(d, _)| d))
         .collect();
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&ok)?);
+        outln!("{}", serde_json::to_string_pretty(&ok)?);
     } else {
-        print!("{}", dynamics_table(&ok));
+        out!("{}", dynamics_table(&ok));
     }
     if let Some(path) = &args.csv {
         let mut w = csv::Writer::from_writer(Vec::new());
@@ -414,18 +427,18 @@ fn table51(json: bool, gravity: bool) -> Result<i32> {
                 gravity,
             })
             .collect();
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        outln!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(0);
     }
-    println!(
+    outln!(
         "Table 5.1 of the thesis (ADAMS, GSTIFF) against ours: a rod of the table's mass with the spec's l1, ω = 40π rad/s, gravity {}\n",
         if gravity { "on" } else { "off" }
     );
-    println!(
+    outln!(
         "| design | mass [kg] | l1 [mm] | thesis peak [N] | our peak [N] | difference | l1 that reproduces the thesis |\n|---|---|---|---|---|---|---|"
     );
     for r in &rows {
-        println!(
+        outln!(
             "| {} | {:.10} | {:.2} | {:.0} | {:.2} | {} | {} |",
             r.design,
             r.mass_kg,

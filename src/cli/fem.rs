@@ -101,9 +101,9 @@ pub fn run(args: FemArgs) -> Result<i32> {
             )?
         };
         if args.json {
-            println!("{}", serde_json::to_string_pretty(&c)?);
+            outln!("{}", serde_json::to_string_pretty(&c)?);
         } else {
-            print!("{}", crate::bench::fem_convergence::markdown(&c));
+            out!("{}", crate::bench::fem_convergence::markdown(&c));
             eprintln!(
                 "wrote {}/convergence.{{md,csv,json,svg}}",
                 args.out.display()
@@ -170,11 +170,11 @@ pub fn run(args: FemArgs) -> Result<i32> {
         json.buckling_load_n = buckling_load_n;
         json.buckling_s = buckling_cost.map(|c| c.0);
         json.buckling_iterations = buckling_cost.map(|c| c.1);
-        println!("{}", serde_json::to_string_pretty(&json)?);
+        outln!("{}", serde_json::to_string_pretty(&json)?);
     } else {
         print_result(&result);
         if let (Some(l), Some(load)) = (result.buckling_load_factor, buckling_load_n) {
-            println!(
+            outln!(
                 "buckling: load factor {l:.3} under {load:.1} N of compression on the big-end bore (small-end bore fixed): linear buckling load {:.0} N; mode in {}",
                 l * load,
                 args.out.join("buckling_mode.vtu").display()
@@ -234,7 +234,7 @@ impl<'a> From<&'a DesignFem> for FemJson<'a> {
 
 fn print_result(d: &DesignFem) {
     let f = &d.fem;
-    println!(
+    outln!(
         "mesh: {} ({} tet10, {} nodes, {} DOFs); load {:.1} N on the big-end bore (r = {:.2} mm), small-end bore fixed (r = {:.2} mm)",
         d.mesh.source,
         f.elements,
@@ -245,21 +245,24 @@ fn print_result(d: &DesignFem) {
         f.fixed_bore.radius_mm
     );
     if let Some(h) = &f.half_model {
-        println!(
+        outln!(
             "half model: the rod is symmetric about z = {:.3} mm; its half ({} tet10, {} nodes) was solved with u_z = 0 on the plane ({} nodes) and mirrored: the DOFs are the half's, the elements, nodes and fields the whole's",
-            h.plane_z_mm, h.elements, h.nodes, h.plane_nodes
+            h.plane_z_mm,
+            h.elements,
+            h.nodes,
+            h.plane_nodes
         );
     }
     if let Some(fallback) = &d.mesh.fallback {
-        println!(
+        outln!(
             "mesh fallback: {fallback} (gmsh could not mesh the reparametrised surface as classified)"
         );
     }
-    println!(
+    outln!(
         "\n| case | max von Mises unaveraged [MPa] | averaged [MPa] | away from fixed bore [MPa] (judged) | max displacement [mm] | resultant error | reaction balance |\n|---|---|---|---|---|---|---|"
     );
     for c in [&f.fx, &f.fy] {
-        println!(
+        outln!(
             "| {} | {:.2} | {:.2} | {:.2} ± {:.1} % | {:.4} | {:.1e} | {:.1e} |",
             c.name,
             c.max_von_mises_unaveraged_mpa,
@@ -272,7 +275,7 @@ fn print_result(d: &DesignFem) {
         );
     }
     if let Some(a) = &d.mesh.adaptive {
-        println!(
+        outln!(
             "\nadaptive refinement to an estimated error of {:.1} % ({:?} after {} meshes, {:.1} s meshing); the size floor is {} (median {:.2} mm)",
             100.0 * a.target_error_rel,
             a.stop,
@@ -281,12 +284,12 @@ fn print_result(d: &DesignFem) {
             a.floor,
             a.facet_spacing_median_mm
         );
-        println!(
+        outln!(
             "\n| case | iteration | elements | DOFs | peak [MPa] | size at peak [mm] | order | estimated error | wall [s] |\n|---|---|---|---|---|---|---|---|---|"
         );
         for c in [&f.fx, &f.fy] {
             for s in &c.adaptive {
-                println!(
+                outln!(
                     "| {} | {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} % | {:.1} |",
                     c.name,
                     s.iteration,
@@ -302,12 +305,17 @@ fn print_result(d: &DesignFem) {
         }
     }
     let t = &f.timings;
-    println!(
+    outln!(
         "\ntimes [s]: assembly {:.2}, symbolic analysis {:.2}, factorisation {:.2}, solve (both cases) {:.2}, stress {:.2}; total {:.2}",
-        t.assembly_s, t.symbolic_s, t.factorisation_s, t.solve_s, t.stress_s, f.total_s
+        t.assembly_s,
+        t.symbolic_s,
+        t.factorisation_s,
+        t.solve_s,
+        t.stress_s,
+        f.total_s
     );
     let v = &d.criterion;
-    println!(
+    outln!(
         "criterion: {:.1} MPa ({}) against {:.1} MPa allowed: safety factor {:.2}, {}",
         v.governing_mpa,
         v.governing_case,
@@ -316,7 +324,7 @@ fn print_result(d: &DesignFem) {
         if v.pass { "pass" } else { "FAIL" }
     );
     for note in &v.model_validity {
-        println!("model validity: {note}");
+        outln!("model validity: {note}");
     }
     for c in [&f.fx, &f.fy] {
         if let Some(vtu) = &c.vtu {
@@ -335,10 +343,10 @@ fn refine(
     let study =
         stages::fem::fem_refinement(design, force, config, &args.out.join("refinement"), sizes)?;
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&study)?);
+        outln!("{}", serde_json::to_string_pretty(&study)?);
         return Ok(0);
     }
-    println!(
+    outln!(
         "refinement study of {} at {:.1} N{}; \"away\": the judged stress (bands at the fixed \
          bore and the sharp edges left out)\n",
         args.design.display(),
@@ -349,11 +357,11 @@ fn refine(
             " (both cases)"
         }
     );
-    println!(
+    outln!(
         "| size [mm] | elements | DOFs | F_x unaveraged / averaged / away [MPa] | F_y unaveraged / averaged / away [MPa] | F_y max displ. [mm] | F_x / F_y recovered peak [MPa] | F_x / F_y est. error | F_x / F_y bound at peak | F_x / F_y energy error | mesh [s] | solve [s] |\n|---|---|---|---|---|---|---|---|---|---|---|---|"
     );
     for l in &study.levels {
-        println!(
+        outln!(
             "| {} | {} | {} | {:.1} / {:.1} / {:.1} | {:.1} / {:.1} / {:.1} | {:.4} | {:.1} / {:.1} | {:.3} / {:.3} | {:.3} / {:.3} | {:.3} / {:.3} | {:.1} | {:.2} |",
             l.size_mm,
             l.elements,

@@ -63,9 +63,9 @@ pub fn run(args: IntegratorsArgs) -> Result<i32> {
     let wp = work_precision_sweep(&scene, &config).map_err(|e| anyhow::anyhow!("{e}"))?;
     let markdown = wp.to_markdown();
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&wp)?);
+        outln!("{}", serde_json::to_string_pretty(&wp)?);
     } else {
-        print!("{markdown}");
+        out!("{markdown}");
     }
     let file = |ext: &str| args.out.join(format!("{stem}{ext}"));
     write_atomic(&file(".md"), markdown.as_bytes())?;

@@ -33,9 +33,9 @@ pub fn run(args: MassArgs) -> Result<i32> {
         .filter_map(|(_, r)| r.as_ref().ok())
         .collect();
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&ok)?);
+        outln!("{}", serde_json::to_string_pretty(&ok)?);
     } else {
-        print!("{}", mass_table(&ok));
+        out!("{}", mass_table(&ok));
     }
     for d in &ok {
         for w in &d.warnings {

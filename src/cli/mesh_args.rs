@@ -27,10 +27,14 @@ impl MeshArgs {
     /// The mesh mode asked for (checked): the user's mesh, one fixed size, adaptive refinement to
     /// `--target-error`, else the configuration's choice.
     pub fn mode(&self, config: &StudyConfig) -> Result<MeshMode> {
+        use crate::config::{MAX_LENGTH_MM, MIN_MESH_SIZE_MM};
         if let Some(size) = self.size
-            && !(size.is_finite() && size > 0.0)
+            && !(size.is_finite() && (MIN_MESH_SIZE_MM..=MAX_LENGTH_MM).contains(&size))
         {
-            bail!("--size must be a positive number of mm, got {size}");
+            bail!(
+                "--size must be a number of mm between {MIN_MESH_SIZE_MM} and {MAX_LENGTH_MM:e} \
+                 (the settings' range of element sizes), got {size:e}"
+            );
         }
         if let Some(t) = self.target_error
             && !(t.is_finite() && t > 0.0 && t < 1.0)

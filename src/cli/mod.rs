@@ -2,6 +2,27 @@
 //!
 //! Exit status: 0 when everything asked for succeeded, 1 when some design failed (the others
 //! are still reported), 2 for a usage error or a failure that stops the whole command.
+//!
+//! Standard output is written through `out!` and `outln!`: a reader that closes the pipe
+//! early (`rodstudy mass … --json | head -c 10`) is a normal end, the command stops quietly
+//! with status 0 (the unwinding runs the destructors: temporary folders are removed).
+
+/// `print!` to standard output; a closed pipe ends the command quietly ([`write_out`]).
+macro_rules! out {
+    ($($arg:tt)*) => {
+        $crate::cli::write_out(format_args!($($arg)*))
+    };
+}
+
+/// `println!` to standard output; a closed pipe ends the command quietly ([`write_out`]).
+macro_rules! outln {
+    () => {
+        $crate::cli::write_out(format_args!("\n"))
+    };
+    ($($arg:tt)*) => {
+        $crate::cli::write_out(format_args!("{}\n", format_args!($($arg)*)))
+    };
+}
 
 mod bench;
 mod check;
@@ -65,8 +86,38 @@ enum Command {
     Solve(solve::SolveArgs),
 }
 
+/// Why writing to standard output stopped the command: the unwinding payload [`main`] turns
+/// into an exit status.
+struct StdoutFailed(i32);
+
+/// Writes to standard output. When the reader has gone (a broken pipe) the command unwinds
+/// without a panic message and [`main`] returns 0; another write error is said once, status 2.
+pub(crate) fn write_out(args: std::fmt::Arguments<'_>) {
+    use std::io::Write;
+    let mut stdout = std::io::stdout().lock();
+    if let Err(e) = stdout.write_fmt(args) {
+        let code = if e.kind() == std::io::ErrorKind::BrokenPipe {
+            0
+        } else {
+            eprintln!("error: cannot write to standard output: {e}");
+            2
+        };
+        std::panic::resume_unwind(Box::new(StdoutFailed(code)));
+    }
+}
+
 /// Parses the command line, runs the command, prints errors; returns the exit status.
 pub fn main() -> i32 {
+    match std::panic::catch_unwind(run_command) {
+        Ok(code) => code,
+        Err(payload) => match payload.downcast::<StdoutFailed>() {
+            Ok(stopped) => stopped.0,
+            Err(panic) => std::panic::resume_unwind(panic),
+        },
+    }
+}
+
+fn run_command() -> i32 {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {

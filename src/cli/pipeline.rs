@@ -16,7 +16,7 @@ pub struct PipelineArgs {
 
 pub fn setup() -> Result<i32> {
     let python = python()?;
-    println!("Python environment ready: {}", python.display());
+    outln!("Python environment ready: {}", python.display());
     Ok(0)
 }
 

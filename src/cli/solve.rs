@@ -61,10 +61,10 @@ pub fn run(args: SolveArgs) -> Result<i32> {
     std::fs::write(&json_path, serde_json::to_string_pretty(&doc)? + "\n")
         .with_context(|| format!("writing {}", json_path.display()))?;
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&doc)?);
+        outln!("{}", serde_json::to_string_pretty(&doc)?);
         return Ok(0);
     }
-    println!(
+    outln!(
         "{}: {} nodes, {} elements, {} DOFs, {} step(s); wall {:.2} s; results in {}",
         args.deck.display(),
         sol.node_ids.len(),
@@ -75,14 +75,19 @@ pub fn run(args: SolveArgs) -> Result<i32> {
         out.display()
     );
     for st in &sol.steps {
-        println!(
+        outln!(
             "step {} (line {}): residual {:.1e}, applied load {:?}",
-            st.step, st.line, st.residual_rel, st.applied_total
+            st.step,
+            st.line,
+            st.residual_rel,
+            st.applied_total
         );
         for (name, r) in &st.reaction_totals {
-            println!(
+            outln!(
                 "  reaction total {name}: [{:.6e}, {:.6e}, {:.6e}]",
-                r[0], r[1], r[2]
+                r[0],
+                r[1],
+                r[2]
             );
         }
         for (name, set) in &st.node_sets {
@@ -109,7 +114,7 @@ pub fn run(args: SolveArgs) -> Result<i32> {
                         format_args!(" RF {:.6e} {:.6e} {:.6e}", r[i][0], r[i][1], r[i][2]),
                     );
                 }
-                println!("{line}");
+                outln!("{line}");
             }
         }
     }

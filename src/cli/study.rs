@@ -114,10 +114,10 @@ pub fn run(args: StudyArgs) -> Result<i32> {
         }
     );
     let designs: Vec<_> = results.designs.iter().map(|d| &d.mass).collect();
-    print!("{}", mass_table(&designs));
+    out!("{}", mass_table(&designs));
     let dynamics: Vec<_> = results.designs.iter().map(|d| &d.dynamics).collect();
-    println!();
-    print!("{}", dynamics_table(&dynamics));
+    outln!();
+    out!("{}", dynamics_table(&dynamics));
     for d in &designs {
         for w in &d.warnings {
             eprintln!("warning: {}: {w}", d.file);

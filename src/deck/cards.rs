@@ -5,7 +5,7 @@ use std::collections::BTreeSet;
 use std::path::Path;
 
 use super::model::*;
-use super::parse::{Card, error, int, num, push_unique, required};
+use super::parse::{Card, error, int, load, num, push_unique, required};
 use crate::fem::error::Result;
 
 /// Parameters each keyword accepts (any other is refused).
@@ -186,6 +186,28 @@ impl Model {
                     }
                     let e = num(path, d, 0, "Young's modulus")?;
                     let nu = num(path, d, 1, "Poisson's ratio")?;
+                    // a solid is stable (its strain energy positive) only for E > 0 and
+                    // −1 < ν < 0.5
+                    if e <= 0.0 {
+                        return Err(error(
+                            path,
+                            d.line,
+                            format!(
+                                "Young's modulus {e} is not positive: no material has E ≤ 0; \
+                                 the line is 'E, ν'"
+                            ),
+                        ));
+                    }
+                    if !(nu > -1.0 && nu < 0.5) {
+                        return Err(error(
+                            path,
+                            d.line,
+                            format!(
+                                "Poisson's ratio {nu} lies outside (−1, 0.5), where no stable \
+                                 solid lies; the line is 'E, ν'"
+                            ),
+                        ));
+                    }
                     let mat = m
                         .materials
                         .get_mut(material.as_ref().expect("checked"))
@@ -202,6 +224,13 @@ impl Model {
                         ));
                     }
                     let rho = num(path, d, 0, "density")?;
+                    if rho < 0.0 {
+                        return Err(error(
+                            path,
+                            d.line,
+                            format!("density {rho} is negative: a mass density is ≥ 0"),
+                        ));
+                    }
                     let mat = m
                         .materials
                         .get_mut(material.as_ref().expect("checked"))
@@ -326,7 +355,7 @@ impl Model {
                                 format!("dof {dof}: only forces 1-3 exist on solid elements"),
                             ));
                         }
-                        let v = num(path, d, 2, "load")?;
+                        let v = load(path, d, 2, "load")?;
                         if d.fields.len() > 3 {
                             return Err(error(
                                 path,
@@ -360,7 +389,7 @@ impl Model {
                         match label.as_str() {
                             "P1" | "P2" | "P3" | "P4" => {
                                 let face = (label.as_bytes()[1] - b'1') as usize;
-                                let p = num(path, d, 2, "pressure")?;
+                                let p = load(path, d, 2, "pressure")?;
                                 if d.fields.len() > 3 {
                                     return Err(error(
                                         path,
@@ -377,7 +406,7 @@ impl Model {
                                 }
                             }
                             "GRAV" => {
-                                let g = num(path, d, 2, "gravity magnitude")?;
+                                let g = load(path, d, 2, "gravity magnitude")?;
                                 let dir = [
                                     num(path, d, 3, "nx")?,
                                     num(path, d, 4, "ny")?,
@@ -516,10 +545,19 @@ impl Model {
             return Err(error(path, state.line, "*STEP without *END STEP"));
         }
         if m.elements.is_empty() {
-            return Err(error(path, 0, "no C3D10/C3D4 elements"));
+            return Err(error(
+                path,
+                0,
+                "no C3D10/C3D4 elements: a deck needs *NODE and *ELEMENT, TYPE=C3D10 (or C3D4) \
+                 cards (an empty or cut-off file has none)",
+            ));
         }
         if m.steps.is_empty() {
-            return Err(error(path, 0, "no *STEP"));
+            return Err(error(
+                path,
+                0,
+                "no *STEP: a deck needs a *STEP with *STATIC, its loads and *END STEP",
+            ));
         }
         Ok(m)
     }

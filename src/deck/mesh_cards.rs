@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use super::model::*;
-use super::parse::{Card, DataLine, error, int, num, push_unique, required};
+use super::parse::{Card, DataLine, coordinate, error, int, push_unique, required};
 use crate::fem::error::Result;
 
 impl Model {
@@ -23,9 +23,9 @@ impl Model {
             }
             let id = int(path, d.line, &d.fields[0], "node id")?;
             let p = [
-                num(path, d, 1, "x")?,
-                num(path, d, 2, "y")?,
-                num(path, d, 3, "z")?,
+                coordinate(path, d, 1, "x")?,
+                coordinate(path, d, 2, "y")?,
+                coordinate(path, d, 3, "z")?,
             ];
             if self.node_index.insert(id, self.nodes.len()).is_some() {
                 return Err(error(path, d.line, format!("node {id} defined twice")));
@@ -71,7 +71,15 @@ impl Model {
             if pending.is_empty() {
                 start = d.line;
             }
-            for f in d.fields.iter().filter(|f| !f.is_empty()) {
+            for f in &d.fields {
+                if f.is_empty() {
+                    return Err(error(
+                        path,
+                        d.line,
+                        "an empty field in an element line (`id, n1, n2, ...`): remove the \
+                         extra comma or fill in the node",
+                    ));
+                }
                 pending.push(int(path, d.line, f, "element line")?);
             }
             if pending.len() > n + 1 {
@@ -95,7 +103,39 @@ impl Model {
                             format!("element {id} refers to undefined node {nid}"),
                         )
                     })?;
+                    if nodes.contains(&i) {
+                        return Err(error(
+                            path,
+                            start,
+                            format!(
+                                "element {id} lists node {nid} twice: its {n} nodes must be \
+                                 distinct; check the element's connectivity"
+                            ),
+                        ));
+                    }
                     nodes.push(i);
+                }
+                // four corners at four places (a distance that underflows is none)
+                for a in 0..4 {
+                    for b in a + 1..4 {
+                        let (p, q) = (self.nodes[nodes[a]], self.nodes[nodes[b]]);
+                        let d2: f64 = (0..3).map(|j| (p[j] - q[j]).powi(2)).sum();
+                        if d2.sqrt() == 0.0 {
+                            return Err(error(
+                                path,
+                                start,
+                                format!(
+                                    "element {id}: its corners {} and {} (nodes {} and {}) \
+                                     coincide: an element needs four corners at distinct \
+                                     places; check the nodes' coordinates",
+                                    a + 1,
+                                    b + 1,
+                                    pending[1 + a],
+                                    pending[1 + b]
+                                ),
+                            ));
+                        }
+                    }
                 }
                 if self.element_index.insert(id, self.elements.len()).is_some() {
                     return Err(error(path, start, format!("element {id} defined twice")));

@@ -29,13 +29,15 @@ use crate::fem::error::{FemError, Result};
 pub use model::Model;
 pub use solve::{DeckSolution, SolveOptions, solve_model};
 
-/// Reads and checks the deck at `path`.
+/// Reads and checks the deck at `path`. A deck is ASCII in its cards; bytes that are not UTF-8
+/// (a Latin-1 `é` in a `**` comment, as older pre-processors write) are read as U+FFFD, so that
+/// a comment never matters and a data line holding one is refused with its line.
 pub fn read_deck(path: &Path) -> Result<Model> {
-    let text = std::fs::read_to_string(path).map_err(|e| FemError::Io {
+    let bytes = std::fs::read(path).map_err(|e| FemError::Io {
         path: path.to_path_buf(),
         error: e,
     })?;
-    read_deck_text(path, &text)
+    read_deck_text(path, &String::from_utf8_lossy(&bytes))
 }
 
 /// Reads a deck from `text` (`path` names it in errors).

@@ -33,8 +33,10 @@
 //! the first *CLOAD (*DLOAD) of a step removes all earlier concentrated (distributed) loads. The
 //! first *NODE PRINT (*EL PRINT, *NODE FILE, *EL FILE) of a step replaces the requests of that kind,
 //! and a step without one keeps the previous step's. Numbers must be finite (`nan`, `inf` and
-//! overflows are refused with their line). Set names are case-insensitive (kept upper-cased, as
-//! ccx prints them).
+//! overflows are refused with their line), and physical: E > 0, −1 < ν < 0.5, ρ ≥ 0, a load
+//! (force, pressure, gravity) at most [`super::parse::MAX_LOAD`] in magnitude, a coordinate at
+//! most [`super::parse::MAX_COORDINATE`]; an element lists distinct nodes, its corners at distinct
+//! places. Set names are case-insensitive (kept upper-cased, as ccx prints them).
 
 use std::collections::{BTreeMap, HashMap};
 

@@ -6,7 +6,9 @@
 //! case-insensitive (upper-cased here), a keyword line ending with a comma continues on the next
 //! line; data fields are separated by commas, blanks around them are not significant, and empty
 //! trailing fields are dropped. Keywords of more than one word (`*SOLID SECTION`, `*NODE PRINT`)
-//! are kept with one blank between the words.
+//! are kept with one blank between the words. A UTF-8 byte-order mark before the first line is
+//! skipped; a data line of empty fields only (`,,,`) is refused with its line (outside
+//! `*HEADING`, whose lines are free text).
 
 use std::path::Path;
 
@@ -62,6 +64,7 @@ pub fn error(path: &Path, line: usize, message: impl Into<String>) -> FemError {
 pub fn cards(path: &Path, text: &str) -> Result<Vec<Card>> {
     let mut out: Vec<Card> = Vec::new();
     let mut continuing = false;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     for (i, raw) in text.lines().enumerate() {
         let ln = i + 1;
         let t = raw.trim();
@@ -103,6 +106,16 @@ pub fn cards(path: &Path, text: &str) -> Result<Vec<Card>> {
         while fields.last().is_some_and(|f| f.is_empty()) {
             fields.pop();
         }
+        if fields.is_empty() && card.keyword != "HEADING" {
+            return Err(error(
+                path,
+                ln,
+                format!(
+                    "a data line of *{} without data (`{t}`): remove it or fill in its fields",
+                    card.keyword
+                ),
+            ));
+        }
         card.data.push(DataLine { line: ln, fields });
     }
     Ok(out)
@@ -138,6 +151,46 @@ pub(super) fn num(path: &Path, d: &DataLine, k: usize, what: &str) -> Result<f64
                 format!("{what}: '{f}' is not a finite number"),
             )
         })
+}
+
+/// Largest magnitude of a load value (force, pressure, gravity): beyond any load in any
+/// consistent units, and where the solution's norms (squares of the loads) leave f64's range.
+pub const MAX_LOAD: f64 = 1e100;
+
+/// Field `k` of `d` as a load value: finite and at most [`MAX_LOAD`] in magnitude.
+pub(super) fn load(path: &Path, d: &DataLine, k: usize, what: &str) -> Result<f64> {
+    let v = num(path, d, k, what)?;
+    if v.abs() > MAX_LOAD {
+        return Err(error(
+            path,
+            d.line,
+            format!(
+                "{what} {v:e} is beyond any load (|value| ≤ {MAX_LOAD:e} in any units) and \
+                 overflows the solution: check the value and its units"
+            ),
+        ));
+    }
+    Ok(v)
+}
+
+/// Largest magnitude of a node coordinate: beyond any model in any units (1e12 mm is a million
+/// kilometres), where the elements' stiffness leaves f64's precision.
+pub const MAX_COORDINATE: f64 = 1e12;
+
+/// Field `k` of `d` as a node coordinate: finite and at most [`MAX_COORDINATE`] in magnitude.
+pub(super) fn coordinate(path: &Path, d: &DataLine, k: usize, what: &str) -> Result<f64> {
+    let v = num(path, d, k, what)?;
+    if v.abs() > MAX_COORDINATE {
+        return Err(error(
+            path,
+            d.line,
+            format!(
+                "{what} {v:e} is beyond any model (|coordinate| ≤ {MAX_COORDINATE:e} in any \
+                 units): check the value and its units"
+            ),
+        ));
+    }
+    Ok(v)
 }
 
 pub(super) fn int(path: &Path, line: usize, f: &str, what: &str) -> Result<i64> {

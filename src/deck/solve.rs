@@ -399,8 +399,31 @@ fn solve_step(
         loads: vec![f],
         quadrature: QuadratureChoice::Degree2,
     };
-    let sol = solve_static(&problem)?;
-    if sol.residual_rel[0].is_nan() || sol.residual_rel[0] > MAX_RESIDUAL_REL {
+    // the solver's refusal (a mechanism) names the step; an element's (an inverted one) goes
+    // to with_deck_element unchanged
+    let sol = solve_static(&problem).map_err(|e| match e {
+        FemError::Solver(m) => {
+            FemError::InvalidInput(format!("step {number} (line {}): {m}", step.line))
+        }
+        e => e,
+    })?;
+    let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+    // a solution beyond f64's range is the data's (loads, constants, coordinates out of any
+    // physical range), never the supports'
+    let overflow = |what: &str| {
+        let largest = problem.loads[0].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        FemError::InvalidInput(format!(
+            "step {number} (line {}): the solution overflows f64 (non-finite {what}; largest \
+             nodal load {largest:.3e}): the loads, the material constants or the node \
+             coordinates are out of range: check their values and units (*CLOAD, *DLOAD, \
+             *ELASTIC, *NODE)",
+            step.line
+        ))
+    };
+    if !(sol.residual_rel[0].is_finite() && finite(&sol.displacements[0])) {
+        return Err(overflow("displacements or residual"));
+    }
+    if sol.residual_rel[0] > MAX_RESIDUAL_REL {
         return Err(FemError::InvalidInput(format!(
             "step {number}: the solution does not satisfy K u = f (relative residual {:.1e}): the \
              supports leave a rigid-body motion free (a mechanism); support the model against \
@@ -411,6 +434,9 @@ fn solve_step(
     let ts = Instant::now();
     let u = &sol.displacements[0];
     let stress = calculix_nodal_stress(mesh, &material, u, options.extrapolation)?;
+    if !finite(stress.nodal.as_flattened()) {
+        return Err(overflow("stresses"));
+    }
     let mut timings = sol.timings;
     timings.stress_s = ts.elapsed().as_secs_f64();
     // an added midside node's reaction goes half to each corner of its edge (the constraint

@@ -858,7 +858,8 @@ pub fn find_stl_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
                 })
                 .collect();
             found.sort();
-            // NAME.step beside NAME.stl: the exact geometry is the design, the STL is not a second one
+            // NAME.step beside NAME.stl: the exact geometry is the design, the STL is not a second
+            // one (it is the design when the STEP cannot be read: stages::mass::load)
             let stems_with_step: std::collections::HashSet<PathBuf> = found
                 .iter()
                 .filter(|p| is_step(p))

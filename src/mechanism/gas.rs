@@ -19,7 +19,8 @@
 //! lines starting with `#` are comments (where a trace states its source), blank lines are
 //! skipped. The angles must start at exactly 0, end at exactly 720 and increase strictly; the
 //! pressure at 720° must equal the one at 0° (the trace is periodic); no absolute pressure
-//! p + 1.01325 bar may be negative (standard atmosphere, ISO 2533). Every refusal names the line.
+//! p + 1.01325 bar may be negative (standard atmosphere, ISO 2533), and no gauge pressure exceed
+//! [`MAX_PRESSURE_BAR`]. A leading UTF-8 byte-order mark is skipped. Every refusal names the line.
 
 use serde::Serialize;
 
@@ -28,6 +29,10 @@ pub const ATMOSPHERE_BAR: f64 = 1.01325;
 
 /// Length of the four-stroke cycle (degrees of crank angle).
 pub const CYCLE_DEG: f64 = 720.0;
+
+/// Largest gauge pressure of a trace row, bar: peak firing pressures of diesel engines reach
+/// about 250–300 bar; a row beyond 5000 bar is a unit slip (Pa, kPa) or a typo.
+pub const MAX_PRESSURE_BAR: f64 = 5000.0;
 
 /// A cylinder pressure trace as read from its CSV (degrees, bar gauge).
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -42,6 +47,8 @@ impl PressureTrace {
     /// Parses and checks a trace (see the module documentation). The error names the line
     /// (1-based, counting the header and comments) and what is wrong with it.
     pub fn parse(text: &str) -> std::result::Result<PressureTrace, String> {
+        // a spreadsheet's UTF-8 export may begin with a byte-order mark
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let mut lines = text
             .lines()
             .enumerate()
@@ -89,6 +96,13 @@ impl PressureTrace {
                 return Err(format!(
                     "line {line}: the crank angle must increase strictly (monotone), but \
                      {angle}° follows {prev}°"
+                ));
+            }
+            if p > MAX_PRESSURE_BAR {
+                return Err(format!(
+                    "line {line}: gauge pressure {p:e} bar at {angle}° is beyond any engine's \
+                     (at most {MAX_PRESSURE_BAR} bar): the column is in bar (a trace in Pa or \
+                     kPa must be converted)"
                 ));
             }
             if p + ATMOSPHERE_BAR < 0.0 {

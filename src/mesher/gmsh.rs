@@ -10,7 +10,7 @@
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
@@ -87,59 +87,11 @@ pub struct MeshedRod {
     pub report: MeshReport,
 }
 
-/// Environment variable: the mesher's time limit in seconds (default 600).
-pub const MESHER_TIMEOUT_VAR: &str = "RODSTUDY_MESHER_TIMEOUT_S";
-
-pub(super) fn mesher_timeout() -> Duration {
-    let secs = std::env::var(MESHER_TIMEOUT_VAR)
-        .ok()
-        .and_then(|v| v.parse::<f64>().ok())
-        .filter(|v| v.is_finite() && *v > 0.0)
-        .unwrap_or(600.0);
-    Duration::from_secs_f64(secs)
-}
-
-/// Runs `command` to completion like `Command::output`, but kills it after `limit` (a reader of
-/// a malformed file can loop forever: meshio's Nastran reader does on a truncated .bdf). The
-/// output goes through temporary files, so a chatty child never blocks on a full pipe.
-fn output_within(command: &mut Command, limit: Duration) -> std::io::Result<std::process::Output> {
-    let stdout = tempfile::tempfile()?;
-    let stderr = tempfile::tempfile()?;
-    let mut child = command
-        .stdout(stdout.try_clone()?)
-        .stderr(stderr.try_clone()?)
-        .spawn()?;
-    let start = Instant::now();
-    let status = loop {
-        if let Some(status) = child.try_wait()? {
-            break status;
-        }
-        if start.elapsed() > limit {
-            let _ = child.kill();
-            let _ = child.wait();
-            return Err(std::io::Error::new(
-                std::io::ErrorKind::TimedOut,
-                format!(
-                    "stopped after {:.0} s (the limit; set {MESHER_TIMEOUT_VAR} to change it)",
-                    limit.as_secs_f64()
-                ),
-            ));
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    };
-    let read = |mut f: std::fs::File| -> std::io::Result<Vec<u8>> {
-        use std::io::{Read, Seek};
-        let mut bytes = Vec::new();
-        f.seek(std::io::SeekFrom::Start(0))?;
-        f.read_to_end(&mut bytes)?;
-        Ok(bytes)
-    };
-    Ok(std::process::Output {
-        status,
-        stdout: read(stdout)?,
-        stderr: read(stderr)?,
-    })
-}
+/// Environment variable: the mesher's time limit in seconds (default 600), the pipeline's one
+/// limit ([`crate::python_env::pipeline_timeout`]).
+pub use crate::python_env::TIMEOUT_VAR as MESHER_TIMEOUT_VAR;
+use crate::python_env::output_within;
+pub(super) use crate::python_env::pipeline_timeout as mesher_timeout;
 
 fn run(python: &Path, script: &Path, args: &[&std::ffi::OsStr]) -> Result<(String, f64)> {
     if !script.is_file() {
@@ -389,21 +341,4 @@ pub fn convert_mesh(
         ],
     )?;
     read_rodmesh(output)
-}
-
-#[cfg(test)]
-mod timeout_tests {
-    use super::*;
-
-    #[test]
-    fn a_hanging_child_is_stopped_with_a_clear_error() {
-        // the TimedOut error is returned only after the child was killed and reaped (no wall
-        // time is asserted: that belongs to benchmarks)
-        let err =
-            output_within(Command::new("sleep").arg("5"), Duration::from_millis(200)).unwrap_err();
-        assert_eq!(err.kind(), std::io::ErrorKind::TimedOut);
-        assert!(err.to_string().contains(MESHER_TIMEOUT_VAR));
-        let ok = output_within(Command::new("echo").arg("hi"), Duration::from_secs(5)).unwrap();
-        assert_eq!(ok.stdout, b"hi\n");
-    }
 }

@@ -62,6 +62,16 @@ pub fn design_key(stl: &Path, config: &StudyConfig) -> Result<String> {
         h.update(std::fs::read(trace.as_path())?);
     }
     h.update(std::fs::read(stl)?);
+    // a STEP's fallback, the STL beside it (stages::mass::load), counts too
+    if crate::geometry::step::is_step(stl) {
+        for ext in ["stl", "STL", "Stl"] {
+            if let Ok(bytes) = std::fs::read(stl.with_extension(ext)) {
+                h.update(b"stl beside");
+                h.update(bytes);
+                break;
+            }
+        }
+    }
     let sidecar = crate::geometry::sidecar::sidecar_path(stl);
     if let Ok(bytes) = std::fs::read(&sidecar) {
         h.update(b"sidecar");

@@ -1,5 +1,8 @@
 //! Study settings: an optional `rodstudy.toml` at the project root (or `--config FILE`); every
-//! setting has the spec's default, unknown keys are errors.
+//! setting has the spec's default, unknown keys are errors, and a value out of its range (below
+//! the physical floor, above the bounds [`MAX_OMEGA_RAD_S`], [`MAX_LENGTH_MM`], [`MAX_INSTANTS`]
+//! …) is refused naming its key when the file is read, before any design is computed. A UTF-8
+//! byte-order mark is skipped.
 //!
 //! ```toml
 //! [driven]            # scene `driven` (SPEC Stage 2)
@@ -54,12 +57,15 @@
 //! #                                    # (gauge); relative to this file's folder. None: no gas force
 //! ```
 
+mod engine;
+
+pub use engine::{EngineConfig, TracePath};
+
 use crate::fem::fatigue::MeanStress;
 use crate::fem::load::BoreLoad;
 use anyhow::{Context, Result, bail};
-use serde::{Deserialize, Deserializer, Serialize};
-use std::path::{Path, PathBuf};
-use std::sync::Arc;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
 
 /// The `driven` scene as configured.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -283,186 +289,36 @@ impl Default for MaterialConfig {
     }
 }
 
-/// The path of a pressure trace. It is interned (each distinct path is stored once for the
-/// life of the process) so that the settings stay `Copy`; written and read as a string.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(transparent)]
-pub struct TracePath(&'static str);
+/// Upper bounds of the settings: beyond them a value is a typo or a unit slip, and the stages
+/// would overflow or run for days. The fastest crank of any engine turns below 1e4 rad/s (95 000
+/// rpm); no rod, bore or mesh size reaches 10 m; no structural metal is 100 GPa strong.
+pub const MAX_OMEGA_RAD_S: f64 = 1e4;
+/// Largest length setting, mm (10 m).
+pub const MAX_LENGTH_MM: f64 = 1e4;
+/// Largest strength setting, MPa.
+pub const MAX_STRENGTH_MPA: f64 = 1e5;
+/// Largest safety or load factor.
+pub const MAX_FACTOR: f64 = 1e3;
+/// Largest mass (kg) or inertia (kg·m²) of the engine's parts.
+pub const MAX_MASS_KG: f64 = 1e6;
+/// Smallest element size setting, mm (10 µm).
+pub const MIN_MESH_SIZE_MM: f64 = 0.01;
+/// Most cycle instants (0.01° apart over a revolution).
+pub const MAX_INSTANTS: usize = 36_000;
 
-impl TracePath {
-    pub fn new(path: &str) -> TracePath {
-        use std::collections::HashSet;
-        use std::sync::{Mutex, OnceLock};
-        static PATHS: OnceLock<Mutex<HashSet<&'static str>>> = OnceLock::new();
-        let mut set = PATHS
-            .get_or_init(Default::default)
-            .lock()
-            .unwrap_or_else(|e| e.into_inner());
-        let interned = match set.get(path) {
-            Some(p) => *p,
-            None => {
-                let p: &'static str = Box::leak(path.to_owned().into_boxed_str());
-                set.insert(p);
-                p
-            }
-        };
-        TracePath(interned)
-    }
-
-    pub fn as_path(&self) -> &'static Path {
-        Path::new(self.0)
-    }
-}
-
-impl<'de> Deserialize<'de> for TracePath {
-    fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
-        Ok(TracePath::new(&String::deserialize(d)?))
-    }
-}
-
-/// The engine around the rod (SPEC "The engine", issue 20): crank, piston and the cylinder
-/// pressure. Defaults: the thesis' test rig (SPEC "The mechanism") without gas force, so that
-/// every default result stays as it is; the default is not written into `results.json`.
-///
-/// With `pressure_trace`, stage 2 runs over the four-stroke cycle (720°) with the gas force
-/// F_gas(φ) = p(φ) · π D²/4 on the piston ([`crate::mechanism::GasForce`]).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct EngineConfig {
-    /// Crank radius r [mm] (stroke 2r).
-    pub crank_radius_mm: f64,
-    /// Piston assembly m₄: piston, pin and rings [kg].
-    pub piston_mass_kg: f64,
-    /// Crank mass m₂ [kg].
-    pub crank_mass_kg: f64,
-    /// Crank inertia I₂ about the main bearing O [kg·m²].
-    pub crank_inertia_kgm2: f64,
-    /// Crank eccentricity e: the crank centroid on OA at e from O, towards A for e > 0 [mm].
-    pub crank_eccentricity_mm: f64,
-    /// Cylinder bore D [mm]: piston area π D²/4 (used only with a pressure trace).
-    pub cylinder_bore_mm: f64,
-    /// Cylinder pressure trace (CSV: `crank_angle_deg` 0–720, 0 = firing top dead centre,
-    /// `pressure_bar` gauge; [`crate::mechanism::PressureTrace`]). Relative to the
-    /// configuration file's folder; stored resolved. None: no gas force.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub pressure_trace: Option<TracePath>,
-}
-
-impl Default for EngineConfig {
-    fn default() -> Self {
-        EngineConfig {
-            crank_radius_mm: 46.0,
-            piston_mass_kg: 5.2269229374,
-            crank_mass_kg: 8.9459574505,
-            crank_inertia_kgm2: 0.016438481547370,
-            crank_eccentricity_mm: 5.190636979,
-            cylinder_bore_mm: 82.0,
-            pressure_trace: None,
+/// Refuses the first `(key, value, max, unit)` whose value exceeds its max, naming the key.
+fn check_upper_bounds(bounds: &[(&str, f64, f64, &str)]) -> Result<()> {
+    for &(key, v, max, unit) in bounds {
+        if v > max {
+            let unit = if unit.is_empty() {
+                String::new()
+            } else {
+                format!(" {unit}")
+            };
+            bail!("`{key}` = {v:e} is out of range: it must be at most {max:e}{unit}");
         }
     }
-}
-
-impl EngineConfig {
-    /// True for the thesis' test rig without gas force (then `[engine]` is not serialized).
-    pub fn is_default(&self) -> bool {
-        *self == EngineConfig::default()
-    }
-
-    /// The mechanism for a rod of centre distance `centre_distance_m`. Values equal to the
-    /// defaults give exactly [`MechanismParams::default`]'s numbers (no mm → m rounding), so the
-    /// default study is unchanged to the bit.
-    pub fn mechanism(
-        &self,
-        centre_distance_m: f64,
-        gravity: bool,
-    ) -> crate::mechanism::MechanismParams {
-        let d = EngineConfig::default();
-        let mut p = crate::mechanism::MechanismParams {
-            centre_distance_m,
-            ..Default::default()
-        }
-        .with_gravity(gravity);
-        let changed = |v: f64, default: f64| (v != default).then_some(v);
-        if let Some(v) = changed(self.crank_radius_mm, d.crank_radius_mm) {
-            p.crank_radius_m = v * 1e-3;
-        }
-        if let Some(v) = changed(self.piston_mass_kg, d.piston_mass_kg) {
-            p.piston_mass_kg = v;
-        }
-        if let Some(v) = changed(self.crank_mass_kg, d.crank_mass_kg) {
-            p.crank_mass_kg = v;
-        }
-        if let Some(v) = changed(self.crank_inertia_kgm2, d.crank_inertia_kgm2) {
-            p.crank_inertia_o_kgm2 = v;
-        }
-        if let Some(v) = changed(self.crank_eccentricity_mm, d.crank_eccentricity_mm) {
-            p.crank_eccentricity_m = v * 1e-3;
-        }
-        p
-    }
-
-    /// Reads and checks the pressure trace; errors name the file and the line.
-    pub fn pressure_trace(&self) -> Result<Option<crate::mechanism::PressureTrace>> {
-        let Some(path) = self.pressure_trace else {
-            return Ok(None);
-        };
-        let path = path.as_path();
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("{}: cannot read the pressure trace", path.display()))?;
-        let trace = crate::mechanism::PressureTrace::parse(&text)
-            .map_err(|e| anyhow::anyhow!("{}: invalid pressure trace: {e}", path.display()))?;
-        Ok(Some(trace))
-    }
-
-    /// The gas force on the piston, F_gas(φ) = p(φ) π D²/4, if a trace is configured.
-    pub fn gas_force(&self) -> Result<Option<Arc<crate::mechanism::GasForce>>> {
-        Ok(self.pressure_trace()?.map(|t| {
-            Arc::new(crate::mechanism::GasForce::from_trace(
-                &t,
-                self.cylinder_bore_mm * 1e-3,
-            ))
-        }))
-    }
-
-    fn check(&self) -> Result<()> {
-        let positive = [
-            ("engine.crank_radius_mm", self.crank_radius_mm),
-            ("engine.piston_mass_kg", self.piston_mass_kg),
-            ("engine.crank_mass_kg", self.crank_mass_kg),
-            ("engine.crank_inertia_kgm2", self.crank_inertia_kgm2),
-            ("engine.cylinder_bore_mm", self.cylinder_bore_mm),
-        ];
-        for (key, v) in positive {
-            if !(v.is_finite() && v > 0.0) {
-                bail!("`{key}` must be a positive number, got {v}");
-            }
-        }
-        let e = self.crank_eccentricity_mm * 1e-3;
-        if !e.is_finite() {
-            bail!("`engine.crank_eccentricity_mm` must be a finite number");
-        }
-        if self.crank_inertia_kgm2 <= self.crank_mass_kg * e * e {
-            bail!(
-                "`engine.crank_inertia_kgm2` = {} must exceed crank_mass e² = {} kg·m² (the \
-                 centroidal inertia I₂ − m₂ e², thesis eq. 3.43, must be positive)",
-                self.crank_inertia_kgm2,
-                self.crank_mass_kg * e * e
-            );
-        }
-        self.pressure_trace()?;
-        Ok(())
-    }
-
-    /// Resolves a relative trace path against the folder of the configuration file.
-    fn resolve(&mut self, config_file: &Path) {
-        if let Some(p) = self.pressure_trace
-            && p.as_path().is_relative()
-        {
-            let folder = config_file.parent().unwrap_or(Path::new(""));
-            let joined: PathBuf = folder.join(p.as_path());
-            self.pressure_trace = Some(TracePath::new(&joined.to_string_lossy()));
-        }
-    }
+    Ok(())
 }
 
 /// Everything a study can be configured with.
@@ -483,9 +339,13 @@ pub struct StudyConfig {
 impl StudyConfig {
     /// Reads and checks a configuration file.
     pub fn read(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path)
+        // bytes that are not UTF-8 (a Latin-1 comment) are read as U+FFFD: in a comment they do
+        // not matter, elsewhere TOML refuses them with their line
+        let bytes = std::fs::read(path)
             .with_context(|| format!("{}: cannot read the configuration", path.display()))?;
-        let mut config: StudyConfig = toml::from_str(&text)
+        let text = String::from_utf8_lossy(&bytes);
+        let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+        let mut config: StudyConfig = toml::from_str(text)
             .with_context(|| format!("{}: invalid configuration", path.display()))?;
         config.engine.resolve(path);
         config
@@ -534,6 +394,84 @@ impl StudyConfig {
                 bail!("`{key}` must be a positive number, got {v}");
             }
         }
+        check_upper_bounds(&[
+            (
+                "driven.omega_rad_s",
+                self.driven.omega_rad_s,
+                MAX_OMEGA_RAD_S,
+                "rad/s (20 000 rpm is 2094 rad/s)",
+            ),
+            ("driven.duration_s", self.driven.duration_s, 3600.0, "s"),
+            (
+                "fem.mesh_size_mm",
+                self.fem.mesh_size_mm,
+                MAX_LENGTH_MM,
+                "mm",
+            ),
+            (
+                "fem.initial_size_mm",
+                self.fem.initial_size_mm,
+                MAX_LENGTH_MM,
+                "mm",
+            ),
+            ("fem.max_size_mm", self.fem.max_size_mm, MAX_LENGTH_MM, "mm"),
+            (
+                "fem.fixed_band_mm",
+                self.fem.fixed_band_mm,
+                MAX_LENGTH_MM,
+                "mm",
+            ),
+            (
+                "fem.singular_band_mm",
+                self.fem.singular_band_mm,
+                MAX_LENGTH_MM,
+                "mm",
+            ),
+            (
+                "criterion.yield_mpa",
+                self.criterion.yield_mpa,
+                MAX_STRENGTH_MPA,
+                "MPa",
+            ),
+            (
+                "material.ultimate_mpa",
+                self.material.ultimate_mpa,
+                MAX_STRENGTH_MPA,
+                "MPa",
+            ),
+            (
+                "criterion.safety_factor",
+                self.criterion.safety_factor,
+                MAX_FACTOR,
+                "",
+            ),
+            (
+                "criterion.fatigue_safety_factor",
+                self.criterion.fatigue_safety_factor,
+                MAX_FACTOR,
+                "",
+            ),
+            (
+                "criterion.buckling_factor",
+                self.criterion.buckling_factor,
+                MAX_FACTOR,
+                "",
+            ),
+        ])?;
+        for (key, v) in [
+            ("fem.mesh_size_mm", self.fem.mesh_size_mm),
+            ("fem.initial_size_mm", self.fem.initial_size_mm),
+            ("fem.max_size_mm", self.fem.max_size_mm),
+            ("fem.min_size_mm", self.fem.min_size_mm),
+            ("fem.step_min_size_mm", self.fem.step_min_size_mm),
+        ] {
+            if v < MIN_MESH_SIZE_MM {
+                bail!(
+                    "`{key}` = {v:e} is out of range: it must be at least {MIN_MESH_SIZE_MM} mm \
+                     (finer elements resolve nothing of a rod and take gmsh beyond its time limit)"
+                );
+            }
+        }
         let e = self.fem.youngs_modulus_pa;
         if !(1e9..=1e12).contains(&e) {
             bail!(
@@ -553,10 +491,17 @@ impl StudyConfig {
         if self.fem.max_iterations == 0 || self.fem.max_dofs < 1000 {
             bail!("`fem.max_iterations` must be at least 1 and `fem.max_dofs` at least 1000");
         }
-        if self.cycle.instants < 360 {
+        if !(360..=MAX_INSTANTS).contains(&self.cycle.instants) {
             bail!(
-                "`cycle.instants` must be at least 360, got {}",
+                "`cycle.instants` must lie between 360 and {MAX_INSTANTS} (0.01° apart; each \
+                 instant costs a pass over the mesh), got {}",
                 self.cycle.instants
+            );
+        }
+        if self.fem.max_iterations > 100 {
+            bail!(
+                "`fem.max_iterations` must be at most 100, got {}",
+                self.fem.max_iterations
             );
         }
         if self.material.endurance_mpa >= self.material.ultimate_mpa {
