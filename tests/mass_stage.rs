@@ -345,3 +345,19 @@ fn sidecar_values_that_disagree_with_the_bores() {
         "{e}"
     );
 }
+
+/// A sidecar saved with a byte-order mark and a Latin-1 comment (é as the byte 0xE9) is read: its
+/// `density` is what counts.
+#[test]
+fn a_sidecar_with_a_bom_and_a_latin1_comment_is_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let rod = d.join("rod.stl");
+    std::fs::copy(root.join("designs/design1.stl"), &rod).unwrap();
+    let mut text = b"\xEF\xBB\xBF# acier tremp\xE9\ndensity = 7850.0\n".to_vec();
+    text.extend_from_slice(b"crank_pin = [0.0, 0.0, 0.0]\npiston_pin = [180.0, 0.0, 0.0]\n");
+    write(d, "rod.toml", &text);
+    let m = mass_of_design(&rod).unwrap_or_else(|e| panic!("{e:#}"));
+    assert_eq!(m.density_kg_m3, 7850.0);
+}

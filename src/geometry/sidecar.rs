@@ -111,10 +111,14 @@ impl DesignSettings {
         if !path.exists() {
             return Sidecar::default().resolve(None);
         }
-        let text = std::fs::read_to_string(&path)
+        // TOML is UTF-8: a byte-order mark is dropped, and bytes of another encoding (a Latin-1
+        // comment) are read as U+FFFD, so that only the keys' values decide
+        let bytes = std::fs::read(&path)
             .with_context(|| format!("{}: cannot read the sidecar", path.display()))?;
-        let sidecar: Sidecar = toml::from_str(&text)
-            .with_context(|| format!("{}: invalid sidecar", path.display()))?;
+        let text = String::from_utf8_lossy(&bytes);
+        let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+        let sidecar: Sidecar =
+            toml::from_str(text).with_context(|| format!("{}: invalid sidecar", path.display()))?;
         sidecar
             .resolve(Some(path.clone()))
             .with_context(|| format!("{}: invalid sidecar", path.display()))
