@@ -17,6 +17,10 @@ Each file reproduces what a real export from another CAD system does, so that st
                        its sidecar metres.toml with `units = "m"`
   two_bodies           the plain rod and a loose block 80 mm beyond its small end: two closed
                        shells that do not touch (STL and STEP)
+  crossed.stl          the plain rod's fine export with the vertex of the big eye's outer wall nearest
+                       (0, 45, 0) pushed to y = 20, through the bore wall: a closed, consistently
+                       oriented surface that crosses itself, which gmsh cannot mesh ("Invalid
+                       boundary mesh (overlapping facets)")
   moved_bore.step      the plain rod's STEP with the cylinder of bore A moved 3 mm along x off the
                        edges that bound it (a broken B-rep, as a hand edit leaves it): refused
 
@@ -164,6 +168,18 @@ def two_bodies(out: pathlib.Path) -> dict:
             "expect": "mass of both bodies with a warning that they are 80 mm apart; FEM refused"}
 
 
+def crossed(out: pathlib.Path) -> dict:
+    volumes, _ = fr.build("plain")
+    verts, tris = fr.mesh_volumes(volumes, "fine", "mm")
+    verts = np.asarray(verts, dtype=np.float32).copy()
+    k = int(np.argmin(np.linalg.norm(verts - np.array([0.0, 45.0, 0.0], dtype=np.float32), axis=1)))
+    moved = verts[k].copy()
+    verts[k, 1] = 20.0
+    (out / "crossed.stl").write_bytes(md.stl_bytes(verts, tris, "rodstudy cad_quirks crossed surface, mm"))
+    return {"files": ["crossed.stl"], "moved_vertex": moved.tolist(), "to_y": 20.0,
+            "expect": "mass accepted; stage 3's mesher failure says where the facets cross"}
+
+
 def moved_bore(out: pathlib.Path) -> dict:
     volumes, _ = fr.build("plain")
 
@@ -180,7 +196,7 @@ def moved_bore(out: pathlib.Path) -> dict:
 
 
 RODS = {"solidworks": solidworks, "bolted_capless": bolted_capless, "metres": metres,
-        "two_bodies": two_bodies, "moved_bore": moved_bore}
+        "two_bodies": two_bodies, "crossed": crossed, "moved_bore": moved_bore}
 
 
 def main(argv=None) -> int:

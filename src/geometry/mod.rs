@@ -4,6 +4,7 @@
 //! - [`stl_file`]: bytes → triangle soup (binary or ASCII, refusing what is not an STL);
 //! - [`weld`]: soup → indexed mesh, equal vertices merged by value;
 //! - [`gaps`]: the holes of an open surface measured (a crack of rounding or a missing face);
+//! - [`self_crossing`]: facets that cross or overlap (a surface intersecting itself);
 //! - [`validate`]: closed, manifold, consistently outward (several bodies: one bonded body, with a
 //!   warning), or a precise error;
 //! - [`mass_properties`]: exact polyhedral integration (volume, centroid, inertia, principal axes);
@@ -25,6 +26,7 @@ pub mod mass_properties;
 pub mod mechanism_frame;
 pub mod mirror_symmetry;
 pub mod primitives;
+pub mod self_crossing;
 pub mod sidecar;
 pub mod simplify;
 pub mod step;

@@ -154,8 +154,10 @@ pub fn fem_and_buckling(
     let mut outcome = match mode {
         MeshMode::Fixed(size_mm) => {
             fem_fixed(design, force_n, config, work_dir, *size_mm, keep, beside)
+                .map_err(|e| crossing_facets_said(design, e))
         }
-        MeshMode::Adaptive(a) => fem_adaptive(design, force_n, config, work_dir, a, keep, beside),
+        MeshMode::Adaptive(a) => fem_adaptive(design, force_n, config, work_dir, a, keep, beside)
+            .map_err(|e| crossing_facets_said(design, e)),
         MeshMode::User(file) => {
             let mut outcome = fem_user_mesh(design, force_n, config, work_dir, file, keep)?;
             outcome.buckling_run = beside.map(|n| buckling_run(&outcome, config, n));
@@ -178,6 +180,33 @@ pub fn fem_and_buckling(
         outcome.solution.system = None;
     }
     Ok(outcome)
+}
+
+/// A mesher failure on an STL whose facets cross each other says so first (gmsh's own words,
+/// "Invalid boundary mesh (overlapping facets)" or a parametrisation it cannot make, do not say
+/// where): the pairs, one of them and where, and what to do. Other errors pass unchanged.
+fn crossing_facets_said(design: &LoadedDesign, e: anyhow::Error) -> anyhow::Error {
+    let message = format!("{e:#}");
+    if design.format.step().is_some() || !(message.contains("gmsh") || message.contains("mesher")) {
+        return e;
+    }
+    let Some(c) = crate::geometry::self_crossing::crossing_facets(&design.mesh) else {
+        return e;
+    };
+    let s = 1.0 / design.settings.units.to_metres();
+    let u = design.settings.units.symbol();
+    e.context(format!(
+        "{}: the STL's surface crosses itself ({} pair(s) of facets cross or overlap, e.g. \
+         triangles {} and {} at ({:.3}, {:.3}, {:.3}) {u}), which gmsh cannot mesh: repair the \
+         surface in CAD (or a mesh repair tool) and export it again",
+        design.file.display(),
+        c.pairs,
+        c.triangles.0,
+        c.triangles.1,
+        c.at.x * s,
+        c.at.y * s,
+        c.at.z * s
+    ))
 }
 
 /// The engine's loads of a design (with a pressure trace): stage 2's record on the configured
