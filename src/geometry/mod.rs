@@ -12,6 +12,7 @@
 //! - [`mechanism_frame`]: the rod's properties in the crank–slider frame (l1, offset, I_zz, I_xx);
 //! - [`bore_finder`]: the pin bores found from the surface (cylinder fits), when no sidecar gives them;
 //! - [`bore_check`]: ray casts proving each pin centre sits in a bore;
+//! - `pin_bores`: the bore check of each pin, and a sidecar's pins against the bores there;
 //! - [`design`]: the whole stage for one design file, and its report record;
 //! - [`primitives`]: closed meshes with known properties, for tests and benchmarks;
 //! - [`error`]: the defects a file can have.
@@ -25,6 +26,7 @@ pub mod half_solid;
 pub mod mass_properties;
 pub mod mechanism_frame;
 pub mod mirror_symmetry;
+mod pin_bores;
 pub mod primitives;
 pub mod self_crossing;
 pub mod sidecar;

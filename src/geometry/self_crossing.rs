@@ -86,7 +86,7 @@ pub fn crossing_facets(mesh: &IndexedMesh) -> Option<Crossing> {
             out
         })
         .collect();
-    found.sort_by(|a, b| (a.0, a.1).cmp(&(b.0, b.1)));
+    found.sort_by_key(|a| (a.0, a.1));
     let &(s, t, at) = found.first()?;
     Some(Crossing {
         pairs: found.len(),
