@@ -6,6 +6,7 @@
 use super::bore_check::RodSurface;
 use super::bore_finder::{Bore, find_bores};
 use super::design::{LoadedDesign, PinsSource};
+use super::weld::IndexedMesh;
 use anyhow::{Result, bail};
 use nalgebra::Vector3;
 
@@ -73,7 +74,8 @@ pub(super) fn pin_bore(
     match surface.bore_radius(name, centre, axis, scale, units) {
         Ok(radius) => {
             if d.pins.source == PinsSource::Sidecar {
-                pin_on_the_bores_axis(d, bores(), name, centre, axis, warnings)?;
+                let near = find_bores(&around_the_axis(&d.mesh, centre, axis, 2.0 * radius));
+                pin_on_the_bores_axis(d, &near, name, centre, axis, warnings)?;
             }
             Ok(PinBore {
                 radius,
@@ -131,6 +133,35 @@ pub(super) fn pin_bore(
             }
         }
         Err(e) => Err(e),
+    }
+}
+
+/// The triangles of `mesh` with a corner within `reach` of the line through `centre` along
+/// `axis` (the vertices kept as they are): where the bore around a pin is, for the bore finder
+/// to fit that bore without searching the whole part (`rodstudy mass` on design 1 subdivided to
+/// 1.6 M triangles, with its sidecar: 1.57 s with the whole search, 0.95 s with this, 2026-11-28).
+fn around_the_axis(
+    mesh: &IndexedMesh,
+    centre: Vector3<f64>,
+    axis: Vector3<f64>,
+    reach: f64,
+) -> IndexedMesh {
+    let near: Vec<bool> = mesh
+        .vertices
+        .iter()
+        .map(|v| {
+            let d = v - centre;
+            (d - axis * axis.dot(&d)).norm() <= reach
+        })
+        .collect();
+    IndexedMesh {
+        vertices: mesh.vertices.clone(),
+        triangles: mesh
+            .triangles
+            .iter()
+            .filter(|t| t.iter().any(|&v| near[v as usize]))
+            .copied()
+            .collect(),
     }
 }
 
