@@ -1,4 +1,4 @@
-//! Benchmark of stage 3's adaptive loop (issue 21 item 3): where each design's time goes, per
+//! Benchmark of stage 3's adaptive loop: where each design's time goes, per
 //! iteration and phase. Each design runs `rodstudy fem DESIGN --json --no-pictures` in its own
 //! process, cold, as a user runs it; the per-iteration phases come from its record
 //! (`fx.adaptive[k].timings`, [`crate::fem::rod::StepTimings`]): the mesh (gmsh, with the STL's

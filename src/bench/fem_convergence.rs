@@ -1,5 +1,5 @@
 //! `rodstudy fem DESIGN --convergence [--sizes 8,5,3.5,2.5] [--target-error R] [--force N]`:
-//! speed against error for stage 3 (issue 10): uniform meshes at each size and the adaptive
+//! speed against error for stage 3: uniform meshes at each size and the adaptive
 //! sequence, per load case DOFs, peak, estimated error, error against the reference, wall time and
 //! peak memory. Each analysis runs in its own process (`rodstudy fem … --json`), so its peak
 //! memory (VmHWM) is its own and the wall times are comparable.

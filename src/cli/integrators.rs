@@ -1,6 +1,6 @@
 //! `rodstudy integrators [--json] [--out DIR] [--repeats N] [--t-end T]`: the work–precision
 //! comparison of the free run (thesis ch. 4) against the exact energy-integral reference; with
-//! `--t-end` other than 1 s, the long-horizon table (issue 21).
+//! `--t-end` other than 1 s, the long-horizon table.
 
 use crate::free_run::{FreeScene, Method, SweepConfig, WorkPrecision, work_precision_sweep};
 use crate::report::atomic_write::write_atomic;

@@ -126,8 +126,7 @@ pub struct FemConfig {
     /// `"auto"` (default): an STL rod symmetric about its mid-plane across the pin axis (within
     /// [`crate::stages::fem::MIRROR_TOLERANCE_MM`]) is meshed and solved as its half with
     /// u_z = 0 on the plane, then mirrored (the same answer on the same mesh, from half the
-    /// DOFs; docs/fem.md); `"off"`: always the whole rod (the route before issue 21's session
-    /// 29). The default is not written into `results.json`.
+    /// DOFs; docs/fem.md); `"off"`: always the whole rod. The default is not written into `results.json`.
     #[serde(skip_serializing_if = "Symmetry::is_default")]
     pub symmetry: Symmetry,
 }

@@ -5,14 +5,14 @@
 //! **Kinks and the floor.** A CAD export approximates a fillet by flat facets meeting at small
 //! kink angles. gmsh remeshes that faceted surface, not the smooth one, so an element smaller than
 //! the facet spacing resolves the kinks, and each kink is a (small) re-entrant corner: an
-//! artificial stress raiser that grows under refinement (measured in issue 10: 0.6 mm elements on
+//! artificial stress raiser that grows under refinement (measured: 0.6 mm elements on
 //! a fillet faceted at 15° read 6 % above the smooth geometry). The adaptive loop therefore never
 //! asks for elements smaller than the local facet spacing: at a point, the spacing of the nearest
 //! kink edge, the mean height of its two facets over it (2·area / edge length: the distance to the
 //! next kinks across it), or the smaller height where one facet is more than twice the other. Only
 //! the kinks near the point count, and a flat face covered by a few huge triangles next to a
-//! fillet does not set the floor on the fillet (issue 18: two 119 mm triangles beside an R15
-//! fillet stopped refinement at 5 mm).
+//! fillet does not set the floor on the fillet (two 119 mm triangles beside an R15 fillet would stop
+//! refinement at 5 mm).
 //!
 //! **Fillet or sharp edge.** An edge whose facets meet at [`FLAT_DEG`] or more but below the
 //! feature angle is a kink of a curved surface. At the feature angle or above it is either a real

@@ -1,4 +1,4 @@
-//! Linear buckling of the rod (issue 20): the F_x case of stage 3 ([`super::rod::rod_fx_case`]:
+//! Linear buckling of the rod: the F_x case of stage 3 ([`super::rod::rod_fx_case`]:
 //! bore B fixed, the pin force on bore A towards B, a compression) handed to the general
 //! eigen-solver of [`super::buckling`].
 

@@ -1,12 +1,11 @@
-//! Small concave fillets, which the adaptive loop's uniform first mesh cannot see (issue 21).
+//! Small concave fillets, which the adaptive loop's uniform first mesh cannot see.
 //!
 //! A recovery-based indicator measures what a mesh resolves. A concave fillet far smaller than
 //! the first mesh's 5 mm elements (an R1 fillet at a shank's step) is meshed as a plain corner of
 //! the facets: the stress concentration it makes is not in the solution, so neither the
 //! recovered stress nor the indicator there says that anything is missing, and the loop refines
 //! elsewhere. Whether such a fillet then got fine elements depended on where gmsh's
-//! classification happened to cut the surface into patches (issue 21, session 28: the stepped
-//! foreign rod's big-end step fillet had 1.0–1.2 mm elements on one route and 5 mm on the other,
+//! classification happened to cut the surface into patches (the stepped foreign rod's big-end step fillet had 1.0–1.2 mm elements on one route and 5 mm on the other,
 //! and its F_x peak read 35 % apart, each route with a bar of 5–16 %).
 //!
 //! So the geometry sets a ceiling on the element size near every concave fillet whose radius is

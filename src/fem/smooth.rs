@@ -5,7 +5,7 @@
 //! export tessellates the B-rep). The straight-sided tet10 mesh of gmsh lies on the facets. What
 //! the facets do to the judged peak is measured by solving the same mesh again with its boundary
 //! moved onto a smooth surface through the same vertices: the difference of the two peaks is the
-//! geometry error (issue 18 item 4), at the discretisation of that mesh, so that the
+//! geometry error, at the discretisation of that mesh, so that the
 //! discretisation error largely cancels between the two.
 //!
 //! **The smooth surface**: curved PN triangles (Vlachos, Peters, Boyd & Mitchell, "Curved PN
@@ -523,7 +523,7 @@ pub struct GeometryCheck {
 /// `mesh`'s own solve: the curved mesh has its connectivity), and returns the judged peaks. With
 /// a symmetry plane in `rod` (`mirror_plane_z_m`), `mesh` is the half model the analysis solved:
 /// the half is curved ([`curve_onto_half`]), solved as the half and mirrored, as the analysis was
-/// (issue 21, session 29: on the mirrored whole the check solved twice the DOFs).
+/// (on the mirrored whole the check would solve twice the DOFs).
 pub fn geometry_check(
     mesh: &TetMesh,
     surface: &SmoothSurface,

@@ -120,7 +120,7 @@ fn symbolic_ref(a: &SparseSym) -> SymbolicSparseColMatRef<'_, usize> {
 /// use every thread of the rayon pool, smaller ones one: on the 2-core machine, in the adaptive
 /// loop, design 1's refined second mesh (1.2e11 flops) factorised in 2.24–2.31 s on two threads
 /// against 2.80–2.83 s on one, its 2.7e10 and 3.0e10 meshes in 1.06–1.09 s against 0.84–0.93 s
-/// (docs/fem.md, session 23). faer's parallel factorisation gives the same bits.
+/// (docs/fem.md). faer's parallel factorisation gives the same bits.
 pub const PARALLEL_FLOPS: f64 = 7e10;
 
 /// A numeric Cholesky factor.

@@ -1,4 +1,4 @@
-//! The gas force on the piston over the four-stroke cycle (SPEC "The engine", issue 20 item 2).
+//! The gas force on the piston over the four-stroke cycle (SPEC "The engine").
 //!
 //! A cylinder pressure trace p(φ) — gauge pressure over the crank angle φ ∈ [0°, 720°], 0 = firing
 //! top dead centre — acts on the piston crown of area A = π D²/4 (D the cylinder bore). The force

@@ -116,7 +116,7 @@ pub fn rod_frame_cycle(
     rod_frame_engine_cycle(params, rod, omega_rad_s, instants, None)
 }
 
-/// The engine's load cycle in the rod frame: with a gas force ([`GasForce`], issue 20 item 5) the
+/// The engine's load cycle in the rod frame: with a gas force ([`GasForce`]) the
 /// four-stroke cycle, 2 × `instants_per_revolution` equally spaced instants over 720° (φ_k = ω t_k,
 /// t_k = (4π/ω)·k/(2n)), the gas force F_gas(φ_k) acting on the piston along global −x (towards the
 /// crank), so that F_B,x(global) = m₄ (ẍ_B − g_x) − F_p + F_gas(φ) as in the closed form

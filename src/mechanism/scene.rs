@@ -17,7 +17,7 @@
 //!
 //! Gravity is switched by [`MechanismParams::gravity`].
 //!
-//! # With a gas force (the engine, issue 20)
+//! # With a gas force (the engine)
 //! [`driven_scene_with_gas`] adds the cylinder pressure's force on the piston
 //! ([`GasForce`], a function of the crank angle with period 720°). The scene
 //! then covers the four-stroke cycle ([`DrivenScene::four_stroke`]: φ from φ₀

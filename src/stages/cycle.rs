@@ -1,6 +1,6 @@
 //! The cycle stage for one design: stress over one crank revolution on stage 3's mesh, with
 //! inertia relief, and the fatigue safety factor (see [`crate::fem::cycle`]). With a cylinder
-//! pressure trace (`[engine] pressure_trace`, issue 20 item 5) the cycle is the engine's
+//! pressure trace (`[engine] pressure_trace`) the cycle is the engine's
 //! four-stroke cycle: 720°, the gas force on the piston at each instant
 //! ([`rod_frame_engine_cycle`]), so the worst instant and the fatigue factor come from the firing
 //! loads and the inertia together.

@@ -132,7 +132,7 @@ pub fn fem(
 /// for the caller to apply ([`apply_buckling`]). The engine study (a pressure trace) judges
 /// buckling under the peak compression itself (an error there is stage 3's). Either buckling
 /// analysis runs beside the geometry check of an STL (`fem DESIGN`'s time beyond the adaptive
-/// loop 0.1–1.0 s less on the five designs; docs/fem.md, session 23).
+/// loop 0.1–1.0 s less on the five designs; docs/fem.md).
 pub fn fem_and_buckling(
     design: &LoadedDesign,
     force_n: f64,

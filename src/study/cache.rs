@@ -19,8 +19,8 @@ use std::path::{Path, PathBuf};
 const PIPELINE_SCRIPTS: [&str; 2] = ["mesh_rod.py", "step_solid.py"];
 
 /// SHA-256 of the program a study runs: the bytes of the running executable and of the pipeline
-/// scripts it calls. The version number alone did not change with the code: a study after a
-/// change of defaults (the half model, issue 21) reused results the earlier program had made.
+/// scripts it calls. The version number alone does not change with the code: a study after a
+/// change of defaults would reuse results the earlier program had made.
 /// Read once per process.
 pub fn program_fingerprint() -> &'static [u8] {
     static FINGERPRINT: std::sync::OnceLock<Vec<u8>> = std::sync::OnceLock::new();

@@ -87,7 +87,7 @@ pub struct ShardRecord {
     /// The ids this shard computed (or tried to), sorted.
     pub designs: Vec<String>,
     /// The designs folder as `--designs` gave it: the shards of one study read one folder
-    /// (empty in records written before 0.3.0's session 26).
+    /// (empty in records written by earlier 0.3.0 builds).
     #[serde(default)]
     pub designs_folder: String,
 }

@@ -226,7 +226,7 @@ fn peak_estimate(h: &PeakHistory, bound: f64, order: f64) -> (f64, bool, f64, f6
     // a peak whose elements were never refined (the size there within 15 % of the coarsest
     // mesh's over the whole sequence) has shown no convergence at all: the meshes differ
     // elsewhere, so neither their spread nor an extrapolation says anything about the error here
-    // (issue 18: sizes 5.7 → 5.0 → 6.4 mm gave "0.13 %" for a true 0.6 %); its estimate stays the
+    // (sizes 5.7 → 5.0 → 6.4 mm would give "0.13 %" for a true 0.6 %); its estimate stays the
     // single-mesh bound of the recovered stress at the peak
     let coarsest = v[..k].iter().map(|x| x.1).fold(h2, f64::max);
     let never_refined = coarsest / h2 < 1.15;
@@ -267,8 +267,8 @@ fn peak_estimate(h: &PeakHistory, bound: f64, order: f64) -> (f64, bool, f64, f6
         // correction, but never less than the last change itself: the peak of a straight-sided
         // mesh on a faceted fillet moves by ~1 % between meshes for reasons no power law
         // describes (which node lands where on the fillet), so a small extrapolated correction
-        // is not trusted below the change that was actually seen (session 24: without this
-        // floor, true / estimated up to 3.8 after two meshes)
+        // is not trusted below the change that was actually seen (without this floor, true /
+        // estimated reaches 3.8 after two meshes)
         correction.abs().max(d2.abs())
     };
     (e / p2, monotone, q, p2 + correction)
@@ -339,7 +339,7 @@ pub fn adaptive_rod(
         let t_it = Instant::now();
         // the first mesh is uniform; a later one is capped at the largest size, as its size map
         // is (capped at the first mesh's size, the low-stress regions could never coarsen, and
-        // every mesh kept the first one's DOFs there: issue 21 item 3)
+        // every mesh would keep the first one's DOFs there)
         let size_map = next_sizes.as_ref().map(|(m, s)| (m, s.as_slice()));
         let ask = MeshAsk {
             iteration,

@@ -48,7 +48,7 @@ fn richardson_extrapolates_power_laws_and_floors_at_the_last_change() {
 
 /// The first mesh is asked uniform at the initial size; every later one from a size map,
 /// capped at the largest size (not at the first mesh's size: the low-stress regions may
-/// coarsen beyond it, issue 21 item 3), and the map never asks for more.
+/// coarsen beyond it), and the map never asks for more.
 #[test]
 fn later_meshes_are_capped_at_the_largest_size_not_the_first() {
     use crate::fem::mesh::structured::{TwoEyePlate, two_eye_plate};
