@@ -631,7 +631,7 @@ pub(crate) mod tests {
         assert_eq!(e.fillet_kinks(), 0);
     }
 
-    /// Issue 18: an R15 fillet exported at 15° per facet (strips the part's whole height long)
+    /// An R15 fillet exported at 15° per facet (strips the part's whole height long)
     /// between two flat faces each covered by two huge triangles. The floor on the fillet, also
     /// next to the huge triangles, is the fillet's facet spacing (2 · 15 · sin 7.5° = 3.9 mm), not
     /// the height of a huge triangle over the fillet's edge; far out on the flat face there is
