@@ -81,6 +81,21 @@ pub struct RodOptions {
     pub exact_geometry: bool,
 }
 
+/// The record of the geometry check ([`super::smooth::geometry_check`]): what was moved, and its cost.
+#[derive(Clone, Copy, Debug, Default, serde::Serialize, serde::Deserialize)]
+pub struct GeometryCheckRecord {
+    /// Boundary nodes moved onto the smooth surface through the STL's vertices.
+    pub moved_nodes: usize,
+    /// Of those, moved only part of the way (an element would have been distorted).
+    pub damped_nodes: usize,
+    /// Boundary nodes with no facet within 2 mm (left where they were).
+    pub unmatched_nodes: usize,
+    /// The largest move, mm.
+    pub max_move_mm: f64,
+    /// Wall time of the check (curving, the second solve), s.
+    pub seconds: f64,
+}
+
 /// Results of one load case. Stresses in MPa, lengths in mm, forces in N.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct LoadCaseResult {
@@ -290,7 +305,7 @@ pub struct FemResult {
     /// The second solve of an STL design's geometry error: its mesh curved onto the smooth surface
     /// through the STL's vertices ([`super::smooth`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub geometry_check: Option<super::smooth::GeometryCheckRecord>,
+    pub geometry_check: Option<GeometryCheckRecord>,
     /// Solved on the half model of a mirror-symmetric rod and mirrored ([`solve_rod_on`]): `nodes`
     /// and `elements` are the whole's, `dofs`, `equations`, `nnz_k`, `nnz_l` the half's system.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -493,21 +493,6 @@ pub fn curve_onto_half(
     Ok((curved, stats))
 }
 
-/// The record of the geometry check ([`geometry_check`]): what was moved, and its cost.
-#[derive(Clone, Copy, Debug, Default, serde::Serialize, serde::Deserialize)]
-pub struct GeometryCheckRecord {
-    /// Boundary nodes moved onto the smooth surface through the STL's vertices.
-    pub moved_nodes: usize,
-    /// Of those, moved only part of the way (an element would have been distorted).
-    pub damped_nodes: usize,
-    /// Boundary nodes with no facet within 2 mm (left where they were).
-    pub unmatched_nodes: usize,
-    /// The largest move, mm.
-    pub max_move_mm: f64,
-    /// Wall time of the check (curving, the second solve), s.
-    pub seconds: f64,
-}
-
 /// The judged peaks of a mesh curved onto the smooth surface ([`geometry_check`]).
 #[derive(Clone, Copy, Debug)]
 pub struct GeometryCheck {
@@ -550,8 +535,8 @@ pub fn geometry_check(
 
 impl GeometryCheck {
     /// Its record (the surface in millimetres).
-    pub fn record(&self) -> GeometryCheckRecord {
-        GeometryCheckRecord {
+    pub fn record(&self) -> super::rod::GeometryCheckRecord {
+        super::rod::GeometryCheckRecord {
             moved_nodes: self.stats.moved_nodes,
             damped_nodes: self.stats.damped_nodes,
             unmatched_nodes: self.stats.unmatched_nodes,

@@ -19,7 +19,7 @@ use super::bore_finder::{FoundPins, PinSearchError, find_pins};
 use super::error::MeshError;
 use super::mass_properties::MassProperties;
 use super::mechanism_frame::{MechanismFrame, RodInFrame};
-use super::pin_bores::{Pin, axis_name, pin_bore};
+use super::pin_bores::{Pin, PinsView, axis_name, pin_bore};
 use super::sidecar::DesignSettings;
 use super::step::{STEP_SCRIPT, StepReport, is_step, read_step};
 use super::stl_file::{StlFormat, read_stl_file};
@@ -507,7 +507,17 @@ fn rod_record(d: &LoadedDesign, stl: &Path) -> Result<DesignMass> {
     let mut warnings = Vec::new();
     // the bores the geometry shows, once, for sidecar pins to be checked against
     let bores = std::cell::OnceCell::new();
-    let crank = pin_bore(d, &surface, Pin::Crank, &bores, &mut warnings).with_context(file);
+    let view = PinsView {
+        mesh: &d.mesh,
+        units: d.settings.units,
+        axis: d.frame.z,
+        crank: d.pins.crank_m,
+        piston: d.pins.piston_m,
+        from_sidecar: d.pins.source == PinsSource::Sidecar,
+        axis_given: d.settings.pin_axis.is_some(),
+        found: d.pins.found.as_ref(),
+    };
+    let crank = pin_bore(&view, &surface, Pin::Crank, &bores, &mut warnings).with_context(file);
     let crank = match (crank, &d.pins.search_error) {
         (Err(e), Some(why)) => {
             return Err(e.context(format!(
@@ -518,7 +528,8 @@ fn rod_record(d: &LoadedDesign, stl: &Path) -> Result<DesignMass> {
         }
         (r, _) => r?,
     };
-    let piston = pin_bore(d, &surface, Pin::Piston, &bores, &mut warnings).with_context(file)?;
+    let piston =
+        pin_bore(&view, &surface, Pin::Piston, &bores, &mut warnings).with_context(file)?;
     if d.pins.source == PinsSource::Sidecar && crank.radius < 0.95 * piston.radius {
         let mm = 1.0 / d.settings.units.to_metres();
         let u = d.settings.units.symbol();

@@ -30,9 +30,22 @@ impl fmt::Display for Location {
     }
 }
 
+/// The boundary loops of an open surface ([`super::gaps::measure_gaps`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Gaps {
+    /// Closed loops of boundary edges.
+    pub loops: usize,
+    /// Width of the widest loop (2 |A| / P), in the mesh's units.
+    pub widest: f64,
+    /// A point of the widest loop (its centre).
+    pub at: nalgebra::Vector3<f64>,
+    /// The widest is narrower than [`super::gaps::ARTEFACT_WIDTH_REL`] of the bounding-box diagonal.
+    pub artefact: bool,
+}
+
 /// The holes of an open mesh, said for the engineer (see [`super::gaps`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct GapsNote(pub Option<super::gaps::Gaps>);
+pub struct GapsNote(pub Option<Gaps>);
 
 impl fmt::Display for GapsNote {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {

@@ -7,6 +7,7 @@
 //! rows of vertices that should have been one, the export's rounding) is an export artefact; a
 //! hole as wide as a facet or wider is a missing face.
 
+pub use super::error::Gaps;
 use super::weld::IndexedMesh;
 use nalgebra::Vector3;
 use std::collections::HashMap;
@@ -14,19 +15,6 @@ use std::collections::HashMap;
 /// A gap narrower than this share of the bounding-box diagonal is taken for an export
 /// artefact (vertices meant to coincide, written apart), wider for a missing face.
 pub const ARTEFACT_WIDTH_REL: f64 = 1e-4;
-
-/// The boundary loops of an open surface.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Gaps {
-    /// Closed loops of boundary edges.
-    pub loops: usize,
-    /// Width of the widest loop (2 |A| / P), in the mesh's units.
-    pub widest: f64,
-    /// A point of the widest loop (its centre).
-    pub at: Vector3<f64>,
-    /// The widest is narrower than [`ARTEFACT_WIDTH_REL`] of the bounding-box diagonal.
-    pub artefact: bool,
-}
 
 /// Measures the boundary loops of `mesh`; `None` when it has no boundary edge.
 pub fn measure_gaps(mesh: &IndexedMesh) -> Option<Gaps> {

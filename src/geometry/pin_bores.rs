@@ -4,11 +4,30 @@
 //! (inside the part, on the bore's axis, along the bore's axis).
 
 use super::bore_check::RodSurface;
+use super::bore_finder::FoundPins;
 use super::bore_finder::{Bore, find_bores};
-use super::design::{LoadedDesign, PinsSource};
+use super::sidecar::Units;
 use super::weld::IndexedMesh;
 use anyhow::{Result, bail};
 use nalgebra::Vector3;
+
+/// What the bore check of a design's pins needs of the design.
+pub(super) struct PinsView<'a> {
+    /// The validated surface, metres.
+    pub(super) mesh: &'a IndexedMesh,
+    /// The file's units (for messages).
+    pub(super) units: Units,
+    /// The pin axis (the mechanism frame's z).
+    pub(super) axis: Vector3<f64>,
+    pub(super) crank: Vector3<f64>,
+    pub(super) piston: Vector3<f64>,
+    /// The pins are the sidecar's.
+    pub(super) from_sidecar: bool,
+    /// The sidecar gives `pin_axis`.
+    pub(super) axis_given: bool,
+    /// The bores the pin search found, when it was asked.
+    pub(super) found: Option<&'a FoundPins>,
+}
 
 /// What the bore check measured of one pin.
 pub(super) struct PinBore {
@@ -34,24 +53,24 @@ pub(super) enum Pin {
 /// The bore check of one pin: a full bore by the in-plane rays; a partial bore (found, or met by
 /// sidecar pins whose in-plane rays leave the part) by the axis ray and the arc's fit.
 pub(super) fn pin_bore(
-    d: &LoadedDesign,
+    d: &PinsView<'_>,
     surface: &RodSurface,
     pin: Pin,
     bores: &std::cell::OnceCell<Vec<Bore>>,
     warnings: &mut Vec<String>,
 ) -> Result<PinBore> {
-    let bores = || bores.get_or_init(|| find_bores(&d.mesh));
-    let scale = d.settings.units.to_metres();
-    let units = d.settings.units.symbol();
-    let axis = d.frame.z;
+    let bores = || bores.get_or_init(|| find_bores(d.mesh));
+    let scale = d.units.to_metres();
+    let units = d.units.symbol();
+    let axis = d.axis;
     let (name, centre, end, letter) = match pin {
-        Pin::Crank => ("crank pin (A)", d.pins.crank_m, "big end", "A"),
-        Pin::Piston => ("piston pin (B)", d.pins.piston_m, "small end", "B"),
+        Pin::Crank => ("crank pin (A)", d.crank, "big end", "A"),
+        Pin::Piston => ("piston pin (B)", d.piston, "small end", "B"),
     };
-    if d.pins.source == PinsSource::Sidecar {
+    if d.from_sidecar {
         sidecar_pin_in_the_part(d, name, centre)?;
     }
-    let found = d.pins.found.as_ref().map(|f| match pin {
+    let found = d.found.map(|f| match pin {
         Pin::Crank => &f.crank,
         Pin::Piston => &f.piston,
     });
@@ -73,8 +92,8 @@ pub(super) fn pin_bore(
     }
     match surface.bore_radius(name, centre, axis, scale, units) {
         Ok(radius) => {
-            if d.pins.source == PinsSource::Sidecar {
-                let near = find_bores(&around_the_axis(&d.mesh, centre, axis, 2.0 * radius));
+            if d.from_sidecar {
+                let near = find_bores(&around_the_axis(d.mesh, centre, axis, 2.0 * radius));
                 pin_on_the_bores_axis(d, &near, name, centre, axis, warnings)?;
             }
             Ok(PinBore {
@@ -82,10 +101,7 @@ pub(super) fn pin_bore(
                 arc_deg: 360.0,
             })
         }
-        Err(e)
-            if d.pins.source == PinsSource::Sidecar
-                && surface.probe(centre, axis).open_share() > 0.0 =>
-        {
+        Err(e) if d.from_sidecar && surface.probe(centre, axis).open_share() > 0.0 => {
             // sidecar pins in an open arc? measure the partial bores whose circle holds the pin
             let partials: Vec<&Bore> = bores()
                 .iter()
@@ -104,7 +120,7 @@ pub(super) fn pin_bore(
                 }
                 let seen = partials
                     .iter()
-                    .map(|b| super::bore_finder::describe(b, d.settings.units))
+                    .map(|b| super::bore_finder::describe(b, d.units))
                     .collect::<Vec<_>>()
                     .join("; ");
                 return Err(e.context(format!(
@@ -167,7 +183,7 @@ fn around_the_axis(
 
 /// A sidecar's pin must lie within the part's bounding box (grown by 1 % of its diagonal): a pin
 /// outside it sits in no bore, whatever the rays from it meet.
-fn sidecar_pin_in_the_part(d: &LoadedDesign, name: &str, centre: Vector3<f64>) -> Result<()> {
+fn sidecar_pin_in_the_part(d: &PinsView<'_>, name: &str, centre: Vector3<f64>) -> Result<()> {
     let (lo, hi) = d.mesh.bounding_box();
     let margin = 0.01 * (hi - lo).norm();
     let outside = (0..3)
@@ -180,8 +196,8 @@ fn sidecar_pin_in_the_part(d: &LoadedDesign, name: &str, centre: Vector3<f64>) -
     if outside == 0.0 {
         return Ok(());
     }
-    let s = 1.0 / d.settings.units.to_metres();
-    let u = d.settings.units.symbol();
+    let s = 1.0 / d.units.to_metres();
+    let u = d.units.symbol();
     let (c, lo, hi) = (centre * s, lo * s, hi * s);
     bail!(
         "the sidecar's {name} at ({:.3}, {:.3}, {:.3}) {u} lies outside the part (its bounding box \
@@ -208,15 +224,15 @@ fn sidecar_pin_in_the_part(d: &LoadedDesign, name: &str, centre: Vector3<f64>) -
 /// still sees a wall all round, so the bore check alone would pass it and measure the wrong
 /// radius and centre distance.
 fn pin_on_the_bores_axis(
-    d: &LoadedDesign,
+    d: &PinsView<'_>,
     bores: &[Bore],
     name: &str,
     centre: Vector3<f64>,
     axis: Vector3<f64>,
     warnings: &mut Vec<String>,
 ) -> Result<()> {
-    let scale = d.settings.units.to_metres();
-    let units = d.settings.units.symbol();
+    let scale = d.units.to_metres();
+    let units = d.units.symbol();
     // the bore around the pin runs along another axis than the sidecar's `pin_axis`
     let around = bores
         .iter()
@@ -227,7 +243,7 @@ fn pin_on_the_bores_axis(
                 .total_cmp(&b.distance_from_axis(centre))
         });
     if let Some(b) = around
-        && d.settings.pin_axis.is_some()
+        && d.axis_given
     {
         let tilt = b.axis_v().dot(&axis).abs().min(1.0).acos().to_degrees();
         if tilt > 1.0 {

@@ -66,7 +66,7 @@ pub struct MeshReport {
     #[serde(default)]
     pub seconds_geometry: Option<f64>,
     /// The `.msh` was written binary in place of ASCII (a natively read mesh): its coordinates are
-    /// read rounded as the ASCII file prints them ([`super::volume::read_msh_as_ascii`]).
+    /// read rounded as the ASCII file prints them ([`super::msh::read_msh_as_ascii`]).
     #[serde(default)]
     pub msh_binary: bool,
     /// Where the mesh's time went (gmsh's phases from its log, and the read measured here).
@@ -157,9 +157,9 @@ pub(super) fn read_reported(json: &str, secs: f64) -> Result<MeshedRod> {
         Some(rodmesh) => (read_rodmesh(rodmesh)?, rodmesh.clone()),
         None => {
             let mesh = if report.msh_binary {
-                super::volume::read_msh_as_ascii(&report.msh, "mm")?
+                super::msh::read_msh_as_ascii(&report.msh, "mm")?
             } else {
-                super::volume::read_volume_mesh_native(&report.msh, "mm")?
+                super::msh::read_msh_exactly(&report.msh, "mm")?
             };
             // gmsh's count may hold nodes no tetrahedron uses; the reader keeps the used ones
             report.nodes = mesh.n_nodes();

@@ -78,31 +78,6 @@ fn read_raw_native(path: &Path) -> Result<RawVolume> {
     }
 }
 
-/// Reads a binary gmsh MSH 4.1 file that the pipeline wrote in place of an ASCII one
-/// (`pipeline/mesh_rod.py`, `written_mesh`: 0.1 s less per mesh) as the ASCII file would have
-/// been read: each coordinate rounded to the 16 significant digits gmsh's ASCII writer prints
-/// (`"%.16g"`), so that the mesh, and every result from it, is the ASCII file's to the last bit.
-/// (A user's binary file is read exactly, by [`read_volume_mesh_native`].)
-pub fn read_msh_as_ascii(path: &Path, units: &str) -> Result<TetMesh> {
-    let scale = unit_scale(units)?;
-    let mut raw = super::msh::read_msh(path)?;
-    for v in raw.nodes.iter_mut().flatten() {
-        *v = as_printed_16g(*v);
-    }
-    raw.finish(path, scale)
-}
-
-/// `v` as C's `printf("%.16g", v)` prints it and a correct parser reads it back: rounded to 16
-/// significant digits (both correctly rounded, so `{:.15e}`'s 16 digits are `%.16g`'s).
-fn as_printed_16g(v: f64) -> f64 {
-    if !v.is_finite() {
-        return v;
-    }
-    format!("{v:.15e}")
-        .parse()
-        .expect("a formatted float parses")
-}
-
 /// Reads a user's volume mesh `path` (the file's numbers in `units`, "mm" or "m") into a mesh in
 /// metres: natively for gmsh MSH 4.1 and `.inp`, else through meshio (`pipeline/mesh_rod.py
 /// convert` in the project's Python environment, which writes `work_dir/user.rodmesh`). Returns
@@ -159,12 +134,12 @@ mod tests {
         ] {
             let expected: f64 = printed.parse().unwrap();
             assert_eq!(
-                super::as_printed_16g(v).to_bits(),
+                super::super::msh::as_printed_16g(v).to_bits(),
                 expected.to_bits(),
                 "{v:e}"
             );
         }
         // a double that needs 17 digits is not its own 16-digit print
-        assert_ne!(super::as_printed_16g(0.1 + 0.2), 0.1 + 0.2);
+        assert_ne!(super::super::msh::as_printed_16g(0.1 + 0.2), 0.1 + 0.2);
     }
 }
