@@ -1,0 +1,319 @@
+//! Stage 3 for one design: mesh the rod with gmsh (tet10, `pipeline/mesh_rod.py`, through
+//! [`crate::mesher`]), solve the two load cases F_x and F_y of the design's peak pin force, refine
+//! adaptively until the estimated error of the judged peak is at most the target (or keep one
+//! fixed mesh, or take the user's), judge the stress criterion (SPEC "Stage 3", "Outputs"). One
+//! function per mesh mode; [`fem`] picks by [`MeshMode`]. The stage writes no report file: it
+//! returns the record, the final mesh and the fields ([`crate::report::fields`] writes them).
+//!
+//! **Any units, any pose.** The rod is meshed in its own frame, in millimetres
+//! ([`super::rod_surface`]). Locations in the results are rod-frame millimetres; the VTU files
+//! are in the same frame.
+//!
+//! The criterion is judged on the convergent measure, the maximum nodally averaged von Mises
+//! stress outside a fixed physical band around the fixed bore (the fully fixed bore edge is a
+//! singularity whose peak grows with refinement), optionally plus its estimated error; the raw
+//! peak is reported beside it.
+//!
+//! **Buckling.** With a pressure trace (`[engine] pressure_trace`, the engine study) the stage
+//! also computes the linear buckling load factor of the rod under its peak compression
+//! ([`buckling`]: the F_x case with that magnitude, B fixed, load on A towards B) and judges it
+//! against `[criterion] buckling_factor`; without a trace the default study does not (its results
+//! stay as they were). `rodstudy fem` always reports it.
+
+use super::criterion::judge_buckling;
+use super::records::{DesignDynamics, DesignFem, LoadedDesign, StageMesh};
+use crate::config::{FemConfig, StudyConfig};
+use crate::fem::buckling::{BucklingMode, BucklingOptions, BucklingSolution};
+use crate::fem::rod::RodSolution;
+use crate::fem::rod_buckling::rod_buckling;
+use crate::fem::statics::FactorisedSystem;
+use crate::fem::{BoreSpec, Material, RodOptions, TetMesh};
+use anyhow::{Context, Result};
+use std::path::{Path, PathBuf};
+
+/// The dihedral angle (degrees) of gmsh's first surface classification: edges sharper than this
+/// are features, not facet kinks of a curved surface.
+pub const FEATURE_ANGLE_DEG: f64 = 40.0;
+
+/// How stage 3 meshes: one fixed mesh, adaptive refinement, or the user's mesh.
+#[derive(Debug, Clone, PartialEq)]
+pub enum MeshMode {
+    /// One gmsh mesh of this size, mm.
+    Fixed(f64),
+    /// Adaptive refinement with these settings.
+    Adaptive(AdaptiveMeshing),
+    /// The user's volume mesh (in the design's units and pose).
+    User(PathBuf),
+}
+
+/// The settings of adaptive refinement (`[fem]` of the configuration, `--target-error`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct AdaptiveMeshing {
+    /// Target estimated relative error of each case's judged peak.
+    pub target_error: f64,
+    /// Uniform size of the first mesh, the largest and the smallest size asked for, mm.
+    pub initial_size_mm: f64,
+    pub max_size_mm: f64,
+    pub min_size_mm: f64,
+    /// The smallest size on a STEP's exact geometry, mm.
+    pub step_min_size_mm: f64,
+    pub max_iterations: usize,
+    pub max_dofs: usize,
+}
+
+impl AdaptiveMeshing {
+    /// The configuration's settings, with the target `target_error`.
+    pub fn new(c: &FemConfig, target_error: f64) -> Self {
+        AdaptiveMeshing {
+            target_error,
+            initial_size_mm: c.initial_size_mm,
+            max_size_mm: c.max_size_mm,
+            min_size_mm: c.min_size_mm,
+            step_min_size_mm: c.step_min_size_mm,
+            max_iterations: c.max_iterations,
+            max_dofs: c.max_dofs,
+        }
+    }
+}
+
+impl MeshMode {
+    /// The configuration's choice: adaptive when `fem.target_error` > 0, else fixed.
+    pub fn from_config(config: &StudyConfig) -> Self {
+        if config.fem.adaptive() {
+            MeshMode::Adaptive(AdaptiveMeshing::new(&config.fem, config.fem.target_error))
+        } else {
+            MeshMode::Fixed(config.fem.mesh_size_mm)
+        }
+    }
+}
+
+/// What stage 3 returns: the record, the mesh it ended on (for the cycle) and the fields of the
+/// final solution (for the report's VTU files and pictures).
+pub struct FemOutcome {
+    pub record: DesignFem,
+    pub mesh: StageMesh,
+    pub solution: RodSolution,
+    /// The buckling analysis [`fem_and_buckling`] ran beside the geometry check, not yet applied
+    /// to the record ([`apply_buckling`]); `None` when none was asked for.
+    pub buckling_run: Option<BucklingRun>,
+}
+
+/// A buckling analysis of stage 3's final mesh under `compression_n` (N), and what came of it.
+pub struct BucklingRun {
+    pub compression_n: f64,
+    pub result: Result<BucklingSolution>,
+}
+
+/// Stage 3 of a loaded design under `force_n` in the mode asked for; gmsh's files go under
+/// `work_dir`.
+pub fn fem(
+    design: &LoadedDesign,
+    force_n: f64,
+    config: &StudyConfig,
+    work_dir: &Path,
+    mode: &MeshMode,
+) -> Result<FemOutcome> {
+    fem_and_buckling(design, force_n, config, work_dir, mode, false, None)
+}
+
+/// [`fem`]; `keep_system`: the outcome keeps the factorised K of the final mesh
+/// ([`RodSolution::system`]) for an analysis the caller runs on it; with `buckling_n` a buckling
+/// analysis under that compression (N) on the final mesh, left in [`FemOutcome::buckling_run`]
+/// for the caller to apply ([`apply_buckling`]). The engine study (a pressure trace) judges
+/// buckling under the peak compression itself (an error there is stage 3's). Either buckling
+/// analysis runs beside the geometry check of an STL (`fem DESIGN`'s time beyond the adaptive
+/// loop 0.1–1.0 s less on the five designs; docs/fem.md).
+pub fn fem_and_buckling(
+    design: &LoadedDesign,
+    force_n: f64,
+    config: &StudyConfig,
+    work_dir: &Path,
+    mode: &MeshMode,
+    keep_system: bool,
+    buckling_n: Option<f64>,
+) -> Result<FemOutcome> {
+    let engine = config.engine.pressure_trace.is_some();
+    let engine_n = if engine {
+        Some(buckling_load(design, config)?)
+    } else {
+        None
+    };
+    // one analysis beside the geometry check: the engine's, else the one asked for
+    let beside = engine_n.or(buckling_n);
+    let keep = keep_system || beside.is_some();
+    let mut outcome = match mode {
+        MeshMode::Fixed(size_mm) => {
+            fem_fixed(design, force_n, config, work_dir, *size_mm, keep, beside)
+                .map_err(|e| crossing_facets_said(design, e))
+        }
+        MeshMode::Adaptive(a) => fem_adaptive(design, force_n, config, work_dir, a, keep, beside)
+            .map_err(|e| crossing_facets_said(design, e)),
+        MeshMode::User(file) => {
+            let mut outcome = fem_user_mesh(design, force_n, config, work_dir, file, keep)?;
+            outcome.buckling_run = beside.map(|n| buckling_run(&outcome, config, n));
+            Ok(outcome)
+        }
+    }?;
+    if engine {
+        let run = outcome
+            .buckling_run
+            .take()
+            .expect("run beside the geometry check");
+        let b = run
+            .result
+            .with_context(|| format!("{}: buckling", design.file.display()))?;
+        apply_buckling(&mut outcome, run.compression_n, b, Some(config));
+        // an analysis under another load asked for besides (`fem --force`) runs after
+        outcome.buckling_run = buckling_n.map(|n| buckling_run(&outcome, config, n));
+    }
+    if !keep_system {
+        outcome.solution.system = None;
+    }
+    Ok(outcome)
+}
+
+/// A mesher failure on an STL whose facets cross each other says so first (gmsh's own words,
+/// "Invalid boundary mesh (overlapping facets)" or a parametrisation it cannot make, do not say
+/// where): the pairs, one of them and where, and what to do. Other errors pass unchanged.
+fn crossing_facets_said(design: &LoadedDesign, e: anyhow::Error) -> anyhow::Error {
+    let message = format!("{e:#}");
+    if design.format.step().is_some() || !(message.contains("gmsh") || message.contains("mesher")) {
+        return e;
+    }
+    let Some(c) = crate::geometry::self_crossing::crossing_facets(&design.mesh) else {
+        return e;
+    };
+    let s = 1.0 / design.settings.units.to_metres();
+    let u = design.settings.units.symbol();
+    e.context(format!(
+        "{}: the STL's surface crosses itself ({} pair(s) of facets cross or overlap, e.g. \
+         triangles {} and {} at ({:.3}, {:.3}, {:.3}) {u}), which gmsh cannot mesh: repair the \
+         surface in CAD (or a mesh repair tool) and export it again",
+        design.file.display(),
+        c.pairs,
+        c.triangles.0,
+        c.triangles.1,
+        c.at.x * s,
+        c.at.y * s,
+        c.at.z * s
+    ))
+}
+
+/// The engine's loads of a design (with a pressure trace): stage 2's record on the configured
+/// engine (closed form), whose peak compression is the buckling case's load and whose largest
+/// pin force across the rod is the F_y case's magnitude. `None` without a trace.
+pub fn engine_loads(design: &LoadedDesign, config: &StudyConfig) -> Result<Option<DesignDynamics>> {
+    if config.engine.pressure_trace.is_none() {
+        return Ok(None);
+    }
+    let mass = super::mass::mass(design)?;
+    let (dynamics, _) = super::dynamics::dynamics_with(
+        &mass,
+        &config.driven_scene(),
+        config.driven.gravity,
+        &config.engine,
+        crate::mechanism::Method::ClosedForm,
+    )?;
+    Ok(Some(dynamics))
+}
+
+/// The load of the buckling case of a design: with a pressure trace its peak compression along
+/// A→B (`peak_compression_n` of stage 2), else its peak pin force (the F_x case's magnitude).
+pub fn buckling_load(design: &LoadedDesign, config: &StudyConfig) -> Result<f64> {
+    let dynamics = match engine_loads(design, config)? {
+        Some(d) => d,
+        None => {
+            let mass = super::mass::mass(design)?;
+            super::dynamics::dynamics_with(
+                &mass,
+                &config.driven_scene(),
+                config.driven.gravity,
+                &config.engine,
+                crate::mechanism::Method::ClosedForm,
+            )?
+            .0
+        }
+    };
+    Ok(dynamics
+        .peak_compression_n
+        .unwrap_or(dynamics.peak_pin_force_n))
+}
+
+/// [`buckling`] on the outcome's mesh and its kept factorisation, not yet applied.
+fn buckling_run(outcome: &FemOutcome, config: &StudyConfig, compression_n: f64) -> BucklingRun {
+    BucklingRun {
+        compression_n,
+        result: buckling(
+            &outcome.mesh,
+            config,
+            compression_n,
+            outcome.solution.system.as_deref(),
+        ),
+    }
+}
+
+/// Linear buckling of the rod on stage 3's mesh (supports as stage 3: bore B fixed) under the
+/// compression `compression_n` on bore A towards B (the F_x case;
+/// [`crate::fem::rod_buckling::rod_buckling`]): the smallest positive load factor λ₁ and its mode.
+/// `system`: the factorised K of stage 3 on this mesh, if kept ([`fem_and_buckling`]).
+pub fn buckling(
+    stage: &StageMesh,
+    config: &StudyConfig,
+    compression_n: f64,
+    system: Option<&FactorisedSystem>,
+) -> Result<BucklingSolution> {
+    Ok(rod_buckling_with(
+        &stage.mesh,
+        &Material::from(&config.fem),
+        &stage.bores,
+        compression_n,
+        system,
+    )?)
+}
+
+/// The rod's buckling analysis with stage 3's settings.
+fn rod_buckling_with(
+    mesh: &TetMesh,
+    material: &Material,
+    bores: &BoreSpec,
+    compression_n: f64,
+    system: Option<&FactorisedSystem>,
+) -> crate::fem::Result<BucklingSolution> {
+    rod_buckling(
+        mesh,
+        material,
+        bores,
+        compression_n,
+        RodOptions::default().quadrature,
+        &BucklingOptions::default(),
+        system,
+    )
+}
+
+/// A buckling analysis' factor into the record, its mode into the fields (the report writes
+/// `buckling_mode.vtu`); with `judge`, the verdict too (`[criterion] buckling_factor`).
+pub fn apply_buckling(
+    outcome: &mut FemOutcome,
+    compression_n: f64,
+    b: BucklingSolution,
+    judge: Option<&StudyConfig>,
+) {
+    outcome.record.buckling_load_factor = Some(b.load_factor);
+    if let Some(config) = judge {
+        judge_buckling(&mut outcome.record.criterion, b.load_factor, config);
+    }
+    outcome.solution.buckling = Some(BucklingMode {
+        load_factor: b.load_factor,
+        load_n: compression_n,
+        mode: b.mode,
+    });
+}
+
+mod routes;
+mod setup;
+
+pub use routes::{
+    USER_MESH_EXTENT_TOLERANCE, USER_MESH_VOLUME_TOLERANCE, fem_adaptive, fem_fixed,
+    fem_refinement, fem_user_mesh,
+};
+pub use setup::{MIRROR_TOLERANCE_MM, UNIFORM_MESH_MAX_DOFS};
