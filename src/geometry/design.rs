@@ -59,22 +59,30 @@ fn units_advice(file: &Path, format: &DesignFormat, settings: &DesignSettings) -
             "an STL has no unit of its own: its numbers are read as {now} (`units` in \
              {sidecar}; mm, cm, m or in)"
         ),
-        DesignFormat::Step(report) if settings.units_given => format!(
-            "the sidecar's `units = \"{now}\"` overrides the unit the STEP declares ({:.4e} m \
-             per unit of OpenCASCADE's): check it, or remove it to take the declared unit",
-            report.metres_per_unit
+        DesignFormat::Step(_) if settings.units_given => format!(
+            "the sidecar's `units = \"{now}\"` overrides the unit the STEP declares: check it, \
+             or remove it from {sidecar} to take the declared unit"
         ),
         DesignFormat::Step(_) => {
             let declared = std::fs::read(file)
                 .ok()
                 .and_then(|b| super::step::declared_length_unit(&String::from_utf8_lossy(&b)))
-                .map_or_else(|| "no readable unit".into(), |(name, _)| format!("{name}s"));
+                .map_or_else(|| "no readable unit".into(), |(name, _)| plural(&name));
             format!(
                 "the STEP declares {declared}; if its numbers are in another unit (an export \
                  that declares mm but writes metres), write `units = \"m\"` (or cm, in, mm) in \
                  {sidecar}: it overrides the declared unit"
             )
         }
+    }
+}
+
+/// A unit's name in the plural, as the messages say it ("millimetres", "inches", "feet").
+fn plural(name: &str) -> String {
+    match name {
+        "inch" => "inches".into(),
+        "foot" => "feet".into(),
+        _ => format!("{name}s"),
     }
 }
 
@@ -362,8 +370,9 @@ fn step_units_override(step: &Path, settings: &DesignSettings) -> Result<(f64, O
     let same = (units.to_metres() / (mm * 1e-3) - 1.0).abs() < 1e-12;
     let note = (!same).then(|| {
         format!(
-            "the file declares its lengths in {declared}s; the sidecar's `units = \"{}\"` \
+            "the file declares its lengths in {}; the sidecar's `units = \"{}\"` \
              overrides that: its numbers are read as {} (pin centres in the sidecar too)",
+            plural(&declared),
             units.symbol(),
             units.symbol()
         )
