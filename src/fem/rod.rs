@@ -165,6 +165,18 @@ pub struct LoadCaseResult {
     pub picture: Option<PathBuf>,
 }
 
+impl LoadCaseResult {
+    /// The one writer of the judged peak's error bar: its discretisation part (the single-mesh
+    /// bound, or the adaptive sequence's estimate), its geometry part (what an STL's facets do;
+    /// `None` where not estimated) and their sum, ε = ε_disc + ε_geom (a bound: the two are not
+    /// independent, and where both move the peak the same way they add).
+    pub fn set_error_bar(&mut self, discretisation: f64, geometry: Option<f64>) {
+        self.estimated_discretisation_error_rel = discretisation;
+        self.estimated_geometry_error_rel = geometry;
+        self.estimated_error_rel = discretisation + geometry.unwrap_or(0.0);
+    }
+}
+
 /// One iteration of the adaptive loop, for one load case.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct AdaptiveStep {
@@ -730,8 +742,8 @@ pub fn rod_fields(st: RodStatic<'_>, options: &RodOptions) -> Result<RodSolution
             reaction_n: reaction,
             reaction_balance_rel: bal,
             solve_residual_rel: sol.residual_rel[c],
-            estimated_error_rel: estimate.summary.single_mesh_estimate(),
-            estimated_discretisation_error_rel: estimate.summary.single_mesh_estimate(),
+            estimated_error_rel: 0.0,
+            estimated_discretisation_error_rel: 0.0,
             estimated_geometry_error_rel: None,
             smooth_surface_peak_mpa: None,
             error_estimate: estimate.summary,
@@ -739,6 +751,8 @@ pub fn rod_fields(st: RodStatic<'_>, options: &RodOptions) -> Result<RodSolution
             vtu: None,
             picture: None,
         });
+        let case = results.last_mut().expect("pushed");
+        case.set_error_bar(estimate.summary.single_mesh_estimate(), None);
         fields.push(field);
         estimates.push(estimate);
     }

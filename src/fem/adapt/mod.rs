@@ -484,8 +484,7 @@ pub fn adaptive_rod(
                 .into_iter()
                 .enumerate()
             {
-                case.estimated_error_rel = estimates[c];
-                case.estimated_discretisation_error_rel = estimates[c];
+                case.set_error_bar(estimates[c], case.estimated_geometry_error_rel);
                 case.adaptive = steps[c].clone();
             }
             solution.result.total_s = t_all.elapsed().as_secs_f64();

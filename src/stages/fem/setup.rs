@@ -303,11 +303,8 @@ impl Setup {
             (smooth, buckled)
         };
         for (case, (g, p)) in [&mut r.fx, &mut r.fy].into_iter().zip(smooth) {
-            let d = case.estimated_error_rel;
-            case.estimated_discretisation_error_rel = d;
-            case.estimated_geometry_error_rel = g;
+            case.set_error_bar(case.estimated_discretisation_error_rel, g);
             case.smooth_surface_peak_mpa = p;
-            case.estimated_error_rel = d + g.unwrap_or(0.0);
         }
         buckled
     }
