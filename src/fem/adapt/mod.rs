@@ -627,10 +627,8 @@ fn refine_sizes(
                 .iter()
                 .map(|&e| want[e as usize])
                 .fold((geometry.ceiling)(p), f64::min);
-            let fl = (geometry.floor)(p)
-                .max(opts.min_size_m)
-                .max(sol.singularity_floor_m[n]);
-            w.max(fl).min(opts.max_size_m)
+            w.max(floor_at(mesh, sol, opts, geometry, n))
+                .min(opts.max_size_m)
         })
         .collect()
 }
