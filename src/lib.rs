@@ -44,5 +44,6 @@ pub mod mechanism;
 pub mod mesher;
 pub mod python_env;
 pub mod report;
+pub mod rod;
 pub mod stages;
 pub mod study;

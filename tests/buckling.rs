@@ -16,9 +16,10 @@ use rodstudy::fem::boundary::boundary_faces;
 use rodstudy::fem::buckling::{BucklingOptions, BucklingProblem, solve_buckling};
 use rodstudy::fem::load::uniform_traction_with_resultant;
 use rodstudy::fem::mesh::structured::box_tet10;
-use rodstudy::fem::rod_buckling::rod_buckling;
 use rodstudy::fem::*;
 use rodstudy::mesher::{mesh_stl, write_rodmesh};
+use rodstudy::rod::buckling::rod_buckling;
+use rodstudy::rod::*;
 
 /// Column [0, L] × [0, b] × [0, b], fixed (all DOFs) on x = 0, a uniform traction of resultant
 /// `force` (N, along x) on the face x = L.

@@ -459,7 +459,7 @@ fn designs_4_and_5_converge_honestly_against_their_exact_geometry() {
         assert!(r.fem.half_model.is_some(), "{id}: meshed as its half");
         assert_eq!(
             adaptive.stop,
-            rodstudy::fem::adapt::StopReason::Converged,
+            rodstudy::rod::adapt::StopReason::Converged,
             "{id}"
         );
         for (case, got) in [("fx", &r.fem.fx), ("fy", &r.fem.fy)] {

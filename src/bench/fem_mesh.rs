@@ -18,13 +18,13 @@ use serde::{Deserialize, Serialize};
 use super::median_time;
 use crate::config::StudyConfig;
 use crate::fem::estimate::estimate_error;
-use crate::fem::facets::reentrant_edges;
 use crate::fem::recovery::recover_stress;
-use crate::fem::rod::{RodOptions, RodSolution, solve_rod_fields};
 use crate::fem::stress::{nodes_away_from, stress_field};
 use crate::fem::{Material, TetMesh};
 use crate::mesher::{read_volume_mesh_meshio, read_volume_mesh_native, volume_reader};
 use crate::report::fields::{write_fem_pictures, write_fem_vtus};
+use crate::rod::facets::reentrant_edges;
+use crate::rod::solve::{RodOptions, RodSolution, solve_rod_fields};
 use crate::stages;
 use crate::stages::fem::FEATURE_ANGLE_DEG;
 use crate::stages::rod_surface::rod_frame_surface;
@@ -402,7 +402,7 @@ fn ccx_run(
     mesh: &TetMesh,
     force_n: f64,
     work: &Path,
-    ours: &crate::fem::FemResult,
+    ours: &crate::rod::FemResult,
     runs: &[WholeRun],
 ) -> Result<CcxRun> {
     let rodmesh = work.join("rod_frame.rodmesh");

@@ -6,11 +6,11 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::fem::bores::BoreSpec;
 use crate::fem::error::Result;
 use crate::fem::material::Material;
-use crate::fem::rod::{FemResult, RodOptions, solve_rod};
 use crate::mesher::{MeshReport, mesh_stl};
+use crate::rod::bores::BoreSpec;
+use crate::rod::solve::{FemResult, RodOptions, solve_rod};
 
 /// What [`bench_rod`] measures.
 #[derive(Clone, Debug, Serialize, Deserialize)]

@@ -191,11 +191,11 @@ struct FemJson<'a> {
     elements: usize,
     nodes: usize,
     force_n: f64,
-    fx: &'a crate::fem::LoadCaseResult,
-    fy: &'a crate::fem::LoadCaseResult,
+    fx: &'a crate::rod::LoadCaseResult,
+    fy: &'a crate::rod::LoadCaseResult,
     mesh: &'a crate::stages::records::MeshSummary,
     criterion: &'a crate::stages::records::StressVerdict,
-    fem: &'a crate::fem::FemResult,
+    fem: &'a crate::rod::FemResult,
     /// Linear buckling load factor λ₁ of the compressive F_x case (B fixed, the load on A
     /// towards B) under `buckling_load_n`; `null` when refused (message on stderr).
     buckling_load_factor: Option<f64>,

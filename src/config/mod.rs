@@ -61,8 +61,8 @@ mod engine;
 
 pub use engine::{EngineConfig, TracePath};
 
-use crate::fem::fatigue::MeanStress;
-use crate::fem::load::BoreLoad;
+use crate::rod::fatigue::MeanStress;
+use crate::rod::pin_load::BoreLoad;
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -273,7 +273,7 @@ pub struct MaterialConfig {
     pub ultimate_mpa: f64,
     pub endurance_mpa: f64,
     /// The mean-stress correction of the fatigue factor: `"goodman"` (default) or `"gerber"`
-    /// ([`crate::fem::fatigue::MeanStress`]); the default is not written into `results.json`.
+    /// ([`crate::rod::fatigue::MeanStress`]); the default is not written into `results.json`.
     #[serde(skip_serializing_if = "MeanStress::is_goodman")]
     pub mean_stress: MeanStress,
 }

@@ -1,4 +1,4 @@
-//! The one error type of the FEM stage: every failure is typed and names what failed (element, bore,
+//! The one error type of the FEM stage: every failure is typed and names what failed (element, surface,
 //! file), so that a bad mesh or a wrong set-up gives a clear message, never a silent number.
 
 use std::path::PathBuf;
@@ -55,28 +55,10 @@ pub enum FemError {
         /// Number of tetrahedra using it.
         count: usize,
     },
-    /// No bore surface found around a pin axis.
-    #[error("{role}: no bore found around the pin axis through ({:.3}, {:.3}, {:.3}) mm: {reason} ({BORE_HINT})",
-        centre_mm[0], centre_mm[1], centre_mm[2])]
-    BoreNotFound {
-        /// Which bore ("fixed small-end bore B" or "loaded big-end bore A").
-        role: String,
-        /// Pin centre, mm.
-        centre_mm: [f64; 3],
-        /// Why.
-        reason: String,
-    },
-    /// A bore surface was found but it does not look like a whole cylinder wall.
-    #[error("{role}: implausible bore surface around ({:.3}, {:.3}, {:.3}) mm: {reason} ({BORE_HINT})",
-        centre_mm[0], centre_mm[1], centre_mm[2])]
-    ImplausibleBore {
-        /// Which bore.
-        role: String,
-        /// Pin centre, mm.
-        centre_mm: [f64; 3],
-        /// Why.
-        reason: String,
-    },
+    /// The problem cannot be posed on the mesh: a surface it loads or supports is not there, or
+    /// not what the problem needs (the message says which and where).
+    #[error("{0}")]
+    Problem(String),
     /// Invalid input values (material, force, options, sizes).
     #[error("invalid input: {0}")]
     InvalidInput(String),
@@ -98,7 +80,7 @@ pub enum FemError {
         /// What is wrong.
         message: String,
     },
-    /// The Python mesher (pipeline/mesh_rod.py) failed.
+    /// The mesher (gmsh, run by [`crate::mesher`]) failed.
     #[error("mesher failed: {0}")]
     Mesher(String),
     /// The sparse solver failed (e.g. the stiffness matrix is not positive definite because the
@@ -118,11 +100,6 @@ impl FemError {
         }
     }
 }
-
-/// What a bore that is not found, or not a cylinder wall, most often means.
-const BORE_HINT: &str = "check the pins (sidecar `crank_pin`/`piston_pin` in the design file's \
-     units, or found from the geometry) and the units (sidecar `units`; a given mesh is in the \
-     design's units and axes)";
 
 /// `:line` of a [`FemError::Parse`], nothing for a whole file (line 0).
 fn line_part(line: usize) -> String {

@@ -22,18 +22,13 @@
 //! *The Finite Element Method* (isoparametric elements, stiffness, quadrature); P. Keast, *Moderate
 //! degree tetrahedral quadrature formulas*, CMAME 55 (1986); D. A. Dunavant, IJNME 21 (1985).
 
-pub mod adapt;
 pub mod assembly;
 pub mod body_force;
-pub mod bores;
 pub mod boundary;
 pub mod buckling;
-pub mod cycle;
 pub mod element;
 pub mod error;
 pub mod estimate;
-pub mod facets;
-pub mod fatigue;
 pub mod geometric_stiffness;
 pub mod load;
 pub mod material;
@@ -42,21 +37,13 @@ pub mod nodal_stress;
 pub mod ordering;
 pub mod quadrature;
 pub mod recovery;
-pub mod refinement;
-pub mod rod;
-pub mod rod_buckling;
-pub mod segment_grid;
 pub mod shape;
-pub mod small_fillets;
-pub mod smooth;
 pub mod solver;
 pub mod statics;
 pub mod stress;
 
-pub use bores::{BoreRole, BoreSpec, BoreSurface};
 pub use element::QuadratureChoice;
 pub use error::{FemError, Result};
 pub use material::Material;
 pub use mesh::TetMesh;
-pub use rod::{FemResult, LoadCaseResult, RodOptions, solve_rod};
 pub use statics::{StaticProblem, StaticSolution, solve_static};

@@ -3,7 +3,7 @@
 //! `pipeline/mesh_rod.py` (gmsh + meshio, in the project's Python environment) runs as a
 //! subprocess under a time limit ([`gmsh`]); meshes come back through the `.rodmesh` hand-off file
 //! ([`rodmesh`]); adaptive refinement hands gmsh a size map as a binary file ([`size_field`]).
-//! [`rod_mesher::GmshRodMesher`] puts these together behind [`crate::fem::adapt::Mesher`], the
+//! [`rod_mesher::GmshRodMesher`] puts these together behind [`crate::rod::adapt::Mesher`], the
 //! small trait the adaptive loop calls (its meshes made in one gmsh session,
 //! [`gmsh_session`], where that works), so that the loop itself can be driven by an in-memory
 //! mesher in tests.

@@ -1,5 +1,5 @@
 //! The meshes of stage 3 from the rod-frame STL: one fixed-size mesh, or the meshes the adaptive
-//! loop asks for ([`crate::fem::adapt::Mesher`]), each in its own folder of the work directory,
+//! loop asks for ([`crate::rod::adapt::Mesher`]), each in its own folder of the work directory,
 //! with gmsh's classified surface cached between them; the loop's meshes of an STL in one gmsh
 //! session ([`GmshSession`]) while it serves them.
 
@@ -10,10 +10,10 @@ use super::gmsh::{
 };
 use super::gmsh_session::GmshSession;
 use super::size_field::write_size_field;
-use crate::fem::adapt::{MeshAsk, Mesher};
 use crate::fem::error::{FemError, Result};
 use crate::fem::mesh::TetMesh;
-use crate::fem::rod::MeshPhases;
+use crate::rod::adapt::{MeshAsk, Mesher};
+use crate::rod::solve::MeshPhases;
 
 /// gmsh on one rod: its surface (an STL in millimetres, in the rod frame), or the exact geometry
 /// of its STEP file moved into the rod frame.

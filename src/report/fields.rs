@@ -7,14 +7,15 @@
 
 use super::atomic_write::write_atomic;
 use super::vtu::{VtuField, write_vtu};
+use crate::fem::TetMesh;
 use crate::fem::buckling::BucklingMode;
-use crate::fem::cycle::{CycleSolution, UnitSolutions};
 use crate::fem::error::{FemError, Result};
 use crate::fem::estimate::ErrorEstimate;
-use crate::fem::rod::{FemResult, LoadCaseResult, RodSolution};
 use crate::fem::stress::StressField;
-use crate::fem::{BoreSurface, TetMesh};
 use crate::report::picture::{PictureOptions, render_tet10_field};
+use crate::rod::BoreSurface;
+use crate::rod::cycle::{CycleSolution, UnitSolutions};
+use crate::rod::solve::{FemResult, LoadCaseResult, RodSolution};
 use crate::stages::records::DesignCycle;
 use std::path::{Path, PathBuf};
 

@@ -414,7 +414,7 @@ pub fn table_cells(r: &RankRow, cols: TableColumns) -> Vec<String> {
 /// The cells of one row of the table for people, in [`HEADERS`] order (plain text).
 pub fn cells(r: &RankRow) -> [String; 15] {
     let dash = || "—".to_string();
-    let stress = |c: Option<&crate::fem::LoadCaseResult>| {
+    let stress = |c: Option<&crate::rod::LoadCaseResult>| {
         c.map_or_else(dash, |c| {
             format!(
                 "{:.1} ± {:.1} % / {:.1} / {:.1}",
@@ -546,7 +546,7 @@ pub fn validity_notes(results: &StudyResults) -> Vec<(String, String)> {
 
 /// What the error bar of a case's judged peak is made of, in words: the discretisation part, the
 /// geometry part (an STL's facets) and which dominates.
-pub fn error_split(case: &crate::fem::LoadCaseResult) -> String {
+pub fn error_split(case: &crate::rod::LoadCaseResult) -> String {
     let label = if case.name == "fx" { "F_x" } else { "F_y" };
     let d = case.estimated_discretisation_error_rel;
     let head = format!(

@@ -5,7 +5,7 @@
 
 use super::records::{DesignCycle, StressVerdict};
 use crate::config::StudyConfig;
-use crate::fem::FemResult;
+use crate::rod::FemResult;
 
 /// Adds the cycle's fatigue safety factor to the verdict when the configuration judges fatigue:
 /// the design passes when it passed so far (statically, and on buckling when judged) and its
@@ -38,7 +38,7 @@ pub const LARGE_DISPLACEMENT_FRACTION: f64 = 0.01;
 pub fn verdict(fem: &FemResult, config: &StudyConfig, centre_distance_mm: f64) -> StressVerdict {
     let allowed = config.criterion.yield_mpa / config.criterion.safety_factor;
     let with_error = config.criterion.with_error;
-    let judged = |c: &crate::fem::LoadCaseResult| {
+    let judged = |c: &crate::rod::LoadCaseResult| {
         c.max_von_mises_away_from_fixed_mpa
             * if with_error {
                 1.0 + c.estimated_error_rel

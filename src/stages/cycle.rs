@@ -1,5 +1,5 @@
 //! The cycle stage for one design: stress over one crank revolution on stage 3's mesh, with
-//! inertia relief, and the fatigue safety factor (see [`crate::fem::cycle`]). With a cylinder
+//! inertia relief, and the fatigue safety factor (see [`crate::rod::cycle`]). With a cylinder
 //! pressure trace (`[engine] pressure_trace`) the cycle is the engine's
 //! four-stroke cycle: 720°, the gas force on the piston at each instant
 //! ([`rod_frame_engine_cycle`]), so the worst instant and the fatigue factor come from the firing
@@ -15,13 +15,13 @@ use super::records::{CosineBoreLoadCases, DesignCycle, DesignMass, StageMesh};
 use crate::config::StudyConfig;
 use crate::fem::QuadratureChoice;
 use crate::fem::body_force::mesh_mass_properties;
-use crate::fem::cycle::{
+use crate::fem::material::Material;
+use crate::mechanism::rod_frame_engine_cycle;
+use crate::rod::cycle::{
     CycleOptions, CycleSolution, DEFAULT_DIRECTION_STEP_DEG, PinBasis, UnitSolutions, combine,
     rod_inertia_of, unit_solutions_for,
 };
-use crate::fem::fatigue::MeanStress;
-use crate::fem::material::Material;
-use crate::mechanism::rod_frame_engine_cycle;
+use crate::rod::fatigue::MeanStress;
 use anyhow::{Context, Result};
 use std::time::Instant;
 

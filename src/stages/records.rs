@@ -3,11 +3,12 @@
 //! function from a loaded design (read and validated once) and settings to one of these; it writes
 //! no file ([`crate::report`] does).
 
-use crate::fem::adapt::StopReason;
-use crate::fem::cycle::CycleInstant;
-use crate::fem::fatigue::MeanStress;
-use crate::fem::{BoreSpec, FemResult, TetMesh};
+use crate::fem::TetMesh;
 use crate::mechanism::{Method, PeakSensitivity};
+use crate::rod::adapt::StopReason;
+use crate::rod::cycle::CycleInstant;
+use crate::rod::fatigue::MeanStress;
+use crate::rod::{BoreSpec, FemResult};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
@@ -238,7 +239,7 @@ pub struct DesignCycle {
     pub seconds: f64,
 }
 
-/// How the cycle superposes a cosine bore load ([`crate::fem::cycle`]): one unit case per pin
+/// How the cycle superposes a cosine bore load ([`crate::rod::cycle`]): one unit case per pin
 /// direction, `direction_step_deg` apart, of which `directions_solved` (those next to a force
 /// direction of the cycle) were solved; `unit_solves` counts them with the four body forces, all
 /// from one factorisation.

@@ -7,10 +7,10 @@
 //! export's units and placement, and the bores sit at (0, 0, 0) and (l, 0, 0).
 
 use super::records::LoadedDesign;
-use crate::fem::BoreSpec;
 use crate::geometry::primitives::{binary_stl, to_soup};
 use crate::geometry::simplify::simplify;
 use crate::geometry::validate::validate;
+use crate::rod::BoreSpec;
 
 /// The rod surface in the rod frame, mm, and the binary STL of it that the mesher reads.
 pub struct RodFrameSurface {

@@ -24,10 +24,11 @@ use super::criterion::judge_buckling;
 use super::records::{DesignDynamics, DesignFem, LoadedDesign, StageMesh};
 use crate::config::{FemConfig, StudyConfig};
 use crate::fem::buckling::{BucklingMode, BucklingOptions, BucklingSolution};
-use crate::fem::rod::RodSolution;
-use crate::fem::rod_buckling::rod_buckling;
 use crate::fem::statics::FactorisedSystem;
-use crate::fem::{BoreSpec, Material, RodOptions, TetMesh};
+use crate::fem::{Material, TetMesh};
+use crate::rod::buckling::rod_buckling;
+use crate::rod::solve::RodSolution;
+use crate::rod::{BoreSpec, RodOptions};
 use anyhow::{Context, Result};
 use std::path::{Path, PathBuf};
 
@@ -254,7 +255,7 @@ fn buckling_run(outcome: &FemOutcome, config: &StudyConfig, compression_n: f64) 
 
 /// Linear buckling of the rod on stage 3's mesh (supports as stage 3: bore B fixed) under the
 /// compression `compression_n` on bore A towards B (the F_x case;
-/// [`crate::fem::rod_buckling::rod_buckling`]): the smallest positive load factor λ₁ and its mode.
+/// [`crate::rod::buckling::rod_buckling`]): the smallest positive load factor λ₁ and its mode.
 /// `system`: the factorised K of stage 3 on this mesh, if kept ([`fem_and_buckling`]).
 pub fn buckling(
     stage: &StageMesh,

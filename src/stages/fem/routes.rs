@@ -5,13 +5,14 @@
 use super::super::records::{AdaptiveSummary, LoadedDesign, MeshSummary};
 use super::super::rod_surface::RodFrameSurface;
 use crate::config::StudyConfig;
-use crate::fem::adapt::{AdaptOptions, GeometrySizes, adaptive_rod};
-use crate::fem::facets::FacetScale;
-use crate::fem::refinement::{RefinementStudy, refinement_study};
-use crate::fem::rod::{rod_fields, solve_rod_on, solve_rod_static};
-use crate::fem::small_fillets::{SMALL_FILLET_RADIUS_MM, SMALL_FILLET_REACH_MM, SmallFillets};
-use crate::fem::{RodOptions, TetMesh};
+use crate::fem::TetMesh;
 use crate::mesher::{MeshReport, read_volume_mesh};
+use crate::rod::RodOptions;
+use crate::rod::adapt::{AdaptOptions, GeometrySizes, adaptive_rod};
+use crate::rod::facets::FacetScale;
+use crate::rod::refinement::{RefinementStudy, refinement_study};
+use crate::rod::small_fillets::{SMALL_FILLET_RADIUS_MM, SMALL_FILLET_REACH_MM, SmallFillets};
+use crate::rod::solve::{rod_fields, solve_rod_on, solve_rod_static};
 use anyhow::{Context, Result};
 use std::path::Path;
 
@@ -69,7 +70,7 @@ pub fn fem_fixed(
 }
 
 /// Stage 3 refined adaptively until the estimated error of each case's judged peak is at most
-/// the target ([`crate::fem::adapt`]), sizes floored at the STL's local facet spacing.
+/// the target ([`crate::rod::adapt`]), sizes floored at the STL's local facet spacing.
 pub fn fem_adaptive(
     design: &LoadedDesign,
     force_n: f64,
@@ -313,7 +314,7 @@ fn check_mesh_is_the_designs(mesh: &TetMesh, surface: &RodFrameSurface) -> Resul
 
 /// A refinement study of a loaded design (`rodstudy fem --refine`): one uniform gmsh mesh per size
 /// in `sizes_mm` (each in `work_dir/<size>mm`), both cases at `force_n`, the band around the fixed
-/// bore from the configuration ([`crate::fem::refinement`]).
+/// bore from the configuration ([`crate::rod::refinement`]).
 pub fn fem_refinement(
     design: &LoadedDesign,
     force_n: f64,

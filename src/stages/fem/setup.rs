@@ -6,12 +6,13 @@ use super::super::criterion::verdict;
 use super::super::records::{DesignFem, LoadedDesign, MeshSummary, StageMesh};
 use super::super::rod_surface::{RodFrameSurface, rod_frame_surface};
 use crate::config::{StudyConfig, Symmetry};
-use crate::fem::facets::{MAX_FILLET_RADIUS_MM, SurfaceEdges};
-use crate::fem::rod::{HalfModel, RodSolution};
-use crate::fem::smooth::{SmoothSurface, geometry_check};
-use crate::fem::{BoreSpec, Material, RodOptions, TetMesh};
+use crate::fem::{Material, TetMesh};
 use crate::mesher::{GmshRodMesher, MESHER_SCRIPT, StepInRodFrame};
 use crate::python_env::{pipeline_script, python};
+use crate::rod::facets::{MAX_FILLET_RADIUS_MM, SurfaceEdges};
+use crate::rod::smooth::{SmoothSurface, geometry_check};
+use crate::rod::solve::{HalfModel, RodSolution};
+use crate::rod::{BoreSpec, RodOptions};
 use anyhow::{Context, Result};
 use std::path::Path;
 
@@ -225,7 +226,7 @@ impl Setup {
     /// its geometry part, and folds the two into `estimated_error_rel` (their sum: a bound). The
     /// geometry part of a STEP design is 0 (the exact geometry, curved elements); of an STL, the
     /// change of the judged peak when the same mesh is curved onto the smooth surface through the
-    /// STL's vertices ([`crate::fem::smooth`]).
+    /// STL's vertices ([`crate::rod::smooth`]).
     ///
     /// With `buckling_n`, the buckling analysis under that compression runs beside the geometry
     /// check, on the kept factorisation, and is returned.

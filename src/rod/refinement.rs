@@ -7,11 +7,11 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use super::bores::BoreSpec;
-use super::error::{FemError, Result};
-use super::material::Material;
-use super::mesh::TetMesh;
-use super::rod::{LoadCaseResult, RodOptions, solve_rod};
-use super::statics::Timings;
+use super::solve::{LoadCaseResult, RodOptions, solve_rod};
+use crate::fem::error::{FemError, Result};
+use crate::fem::material::Material;
+use crate::fem::mesh::TetMesh;
+use crate::fem::statics::Timings;
 
 /// The stress measures of one case at one size.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -28,7 +28,7 @@ pub struct CaseMeasures {
     /// Estimated relative error of the "away" maximum.
     pub estimated_error_rel: f64,
     /// The recovery estimates on this mesh.
-    pub error_estimate: super::estimate::EstimateSummary,
+    pub error_estimate: crate::fem::estimate::EstimateSummary,
 }
 
 impl From<&LoadCaseResult> for CaseMeasures {

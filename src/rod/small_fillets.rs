@@ -93,8 +93,8 @@ impl SmallFillets {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fem::facets::MAX_FILLET_RADIUS_MM;
-    use crate::fem::facets::tests::{l_outline, prism};
+    use crate::rod::facets::MAX_FILLET_RADIUS_MM;
+    use crate::rod::facets::tests::{l_outline, prism};
 
     fn fillets(r: f64, facets: usize) -> (SmallFillets, f64) {
         let (v, t) = prism(&l_outline(20.0, 4.0, r, facets), 6.0);

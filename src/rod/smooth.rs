@@ -1,5 +1,5 @@
 //! A smooth surface through the STL's vertices, and a tet10 mesh curved onto it: the second
-//! geometry of the STL route's geometry error ([`super::rod`]'s `estimated_geometry_error_rel`).
+//! geometry of the STL route's geometry error ([`super::solve`]'s `estimated_geometry_error_rel`).
 //!
 //! An STL is the part's surface cut into flat facets; its vertices lie on the true surface (a CAD
 //! export tessellates the B-rep). The straight-sided tet10 mesh of gmsh lies on the facets. What
@@ -34,11 +34,11 @@ use std::collections::HashMap;
 
 use nalgebra::Vector3;
 
-use super::boundary::boundary_faces;
-use super::error::Result;
 use super::facets::{EdgeKind, SurfaceEdges};
-use super::mesh::TetMesh;
-use super::shape::TET10_EDGES;
+use crate::fem::boundary::boundary_faces;
+use crate::fem::error::Result;
+use crate::fem::mesh::TetMesh;
+use crate::fem::shape::TET10_EDGES;
 
 /// How much wider than every other planar region around a vertex a region must be to set the
 /// vertex normal alone (a flat face that a fillet meets tangentially).
@@ -391,8 +391,8 @@ pub fn curve_onto_half(
     scale: f64,
     plane: Option<(f64, f64)>,
 ) -> Result<(TetMesh, CurveStats)> {
-    use super::element::{check_jacobian, corner_volume};
-    use super::quadrature::TET14;
+    use crate::fem::element::{check_jacobian, corner_volume};
+    use crate::fem::quadrature::TET14;
     use rayon::prelude::*;
     let on_plane = |n: usize| plane.is_some_and(|(c, tol)| (mesh.nodes()[n][2] - c).abs() <= tol);
     let faces = boundary_faces(mesh)?;
@@ -512,17 +512,17 @@ pub struct GeometryCheck {
 pub fn geometry_check(
     mesh: &TetMesh,
     surface: &SmoothSurface,
-    material: &super::material::Material,
+    material: &crate::fem::material::Material,
     bores: &super::bores::BoreSpec,
     force_n: f64,
-    rod: &super::rod::RodOptions,
+    rod: &super::solve::RodOptions,
 ) -> Result<GeometryCheck> {
     let start = std::time::Instant::now();
     let plane = rod
         .mirror_plane_z_m
-        .map(|c| (c, super::rod::mirror_plane_tolerance(mesh)));
+        .map(|c| (c, super::solve::mirror_plane_tolerance(mesh)));
     let (curved, stats) = curve_onto_half(mesh, surface, 1e3, plane)?;
-    let (_, sol) = super::rod::solve_rod_on(curved, material, bores, force_n, rod)?;
+    let (_, sol) = super::solve::solve_rod_on(curved, material, bores, force_n, rod)?;
     Ok(GeometryCheck {
         peaks_mpa: [
             sol.result.fx.max_von_mises_away_from_fixed_mpa,
@@ -535,8 +535,8 @@ pub fn geometry_check(
 
 impl GeometryCheck {
     /// Its record (the surface in millimetres).
-    pub fn record(&self) -> super::rod::GeometryCheckRecord {
-        super::rod::GeometryCheckRecord {
+    pub fn record(&self) -> super::solve::GeometryCheckRecord {
+        super::solve::GeometryCheckRecord {
             moved_nodes: self.stats.moved_nodes,
             damped_nodes: self.stats.damped_nodes,
             unmatched_nodes: self.stats.unmatched_nodes,
@@ -549,7 +549,7 @@ impl GeometryCheck {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fem::facets::{MAX_FILLET_RADIUS_MM, SurfaceEdges};
+    use crate::rod::facets::{MAX_FILLET_RADIUS_MM, SurfaceEdges};
 
     /// A prism over a regular n-gon of radius 1 (height 2), side walls of one quad per side:
     /// points of the side facets and of the caps' rims move onto the circle through the vertices

@@ -18,11 +18,13 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::boundary::{BoundaryFace, dot, face_area, face_coords, face_normal, face_point, norm};
-use super::error::{FemError, Result};
-use super::load::BoreLoad;
-use super::mesh::TetMesh;
-use super::quadrature::TRI6;
+use crate::fem::boundary::{
+    BoundaryFace, dot, face_area, face_coords, face_normal, face_point, norm,
+};
+use crate::fem::error::{FemError, Result};
+use crate::fem::mesh::TetMesh;
+use crate::fem::quadrature::TRI6;
+use crate::rod::pin_load::BoreLoad;
 
 /// The two pin axes and the tolerances of the bore search. Centres in metres.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -47,7 +49,7 @@ pub struct BoreSpec {
     #[serde(default = "full_arc")]
     pub fixed_arc_deg: f64,
     /// How a pin's force is spread over its bore: uniform (default) or a cosine bearing
-    /// pressure on the pressed half ([`super::load::BoreLoad`], `[fem] bore_load`).
+    /// pressure on the pressed half ([`crate::rod::pin_load::BoreLoad`], `[fem] bore_load`).
     #[serde(default)]
     pub bore_load: BoreLoad,
 }
@@ -185,16 +187,16 @@ pub fn find_bore(
 ) -> Result<BoreSurface> {
     let axis = spec.unit_axis()?;
     let centre_mm = centre.map(|v| v * 1e3);
-    let not_found = |reason: String| FemError::BoreNotFound {
-        role: role.to_string(),
-        centre_mm,
-        reason,
+    let not_found = |reason: String| {
+        bore_error(
+            role,
+            "no bore found around the pin axis through",
+            centre_mm,
+            &reason,
+        )
     };
-    let implausible = |reason: String| FemError::ImplausibleBore {
-        role: role.to_string(),
-        centre_mm,
-        reason,
-    };
+    let implausible =
+        |reason: String| bore_error(role, "implausible bore surface around", centre_mm, &reason);
     let radial = |p: [f64; 3]| -> ([f64; 3], f64) {
         let v = [p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]];
         let along = dot(v, axis);
@@ -260,7 +262,7 @@ pub fn find_bore(
         let v = [t[0] - d * axis[0], t[1] - d * axis[1], t[2] - d * axis[2]];
         v.map(|c| c / norm(v))
     };
-    let e2 = super::boundary::cross(axis, e1);
+    let e2 = crate::fem::boundary::cross(axis, e1);
     let (mut zmin, mut zmax) = (f64::INFINITY, f64::NEG_INFINITY);
     let mut angles = Vec::with_capacity(3 * faces.len());
     // each face's area along the axis (its three corners' axial coordinates), for the length
@@ -353,13 +355,28 @@ pub fn find_bores(
         .filter(|n| fixed.nodes.binary_search(n).is_ok())
         .count();
     if shared > 0 {
-        return Err(FemError::ImplausibleBore {
-            role: BoreRole::Fixed.to_string(),
-            centre_mm: spec.fixed_centre_m.map(|v| v * 1e3),
-            reason: format!("it shares {shared} nodes with the loaded bore"),
-        });
+        return Err(bore_error(
+            BoreRole::Fixed,
+            "implausible bore surface around",
+            spec.fixed_centre_m.map(|v| v * 1e3),
+            &format!("it shares {shared} nodes with the loaded bore"),
+        ));
     }
     Ok((loaded, fixed))
+}
+
+/// What a bore that is not found, or not a cylinder wall, most often means.
+const BORE_HINT: &str = "check the pins (sidecar `crank_pin`/`piston_pin` in the design file's \
+     units, or found from the geometry) and the units (sidecar `units`; a given mesh is in the \
+     design's units and axes)";
+
+/// The refusal of a bore: which, what is wrong (`what` ends in "around …"), where (mm), why, and
+/// what it most often means.
+fn bore_error(role: BoreRole, what: &str, centre_mm: [f64; 3], reason: &str) -> FemError {
+    let [x, y, z] = centre_mm;
+    FemError::Problem(format!(
+        "{role}: {what} ({x:.3}, {y:.3}, {z:.3}) mm: {reason} ({BORE_HINT})"
+    ))
 }
 
 #[cfg(test)]

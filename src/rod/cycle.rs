@@ -8,7 +8,7 @@
 //! Then the reaction at B is the piston pin's force on the rod, F_B, by the rod's Newton–Euler
 //! equations, provided the body forces integrate to the same mass and centroid the dynamics used:
 //! the caller passes kinematics and pin forces computed with the mesh's own mass properties
-//! ([`super::body_force::mesh_mass_properties`]).
+//! ([`crate::fem::body_force::mesh_mass_properties`]).
 //!
 //! The load is linear in six coefficients (Zienkiewicz–Taylor–Zhu, superposition of linear
 //! solutions):
@@ -18,7 +18,7 @@
 //! so σ(t) = Σ c_k(t) σ_k at every node, from six solves of one Cholesky factor; the per-instant
 //! cost is a 6-term combination per node.
 //!
-//! **Cosine bore load** (`[fem] bore_load = "cosine"`, [`super::load::cosine_pressure_with_resultant`]):
+//! **Cosine bore load** (`[fem] bore_load = "cosine"`, [`crate::fem::load::cosine_pressure_with_resultant`]):
 //! the pressed half of the bore turns with the force, so the pin load is no longer linear in
 //! (F_x, F_y). It is linear in |F| for a fixed direction, so the pin is given one unit case per
 //! direction θ_j = j Δ (rod frame, Δ = [`CycleOptions::direction_step_deg`], 5° by default: 72
@@ -37,18 +37,21 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::body_force::{BodyShape, MeshMassProperties, body_force_load, mesh_mass_properties};
 use super::bores::{BoreSpec, find_bores};
-use super::boundary::boundary_faces;
-use super::element::QuadratureChoice;
-use super::error::{FemError, Result};
 use super::fatigue::{MeanStress, amplitude_and_mean, signed_von_mises};
-use super::load::{BoreLoad, pin_load, uniform_traction_with_resultant};
-use super::material::{Material, von_mises};
-use super::mesh::TetMesh;
-use super::statics::{SolveStats, StaticProblem, Timings, solve_static};
-use super::stress::{nodes_away_from, nodes_away_from_segments, stress_field};
+use crate::fem::body_force::{
+    BodyShape, MeshMassProperties, body_force_load, mesh_mass_properties,
+};
+use crate::fem::boundary::boundary_faces;
+use crate::fem::element::QuadratureChoice;
+use crate::fem::error::{FemError, Result};
+use crate::fem::load::uniform_traction_with_resultant;
+use crate::fem::material::{Material, von_mises};
+use crate::fem::mesh::TetMesh;
+use crate::fem::statics::{SolveStats, StaticProblem, Timings, solve_static};
+use crate::fem::stress::{nodes_away_from, nodes_away_from_segments, stress_field};
 use crate::mechanism::RodFrameInstant;
+use crate::rod::pin_load::{BoreLoad, pin_load};
 
 /// The six unit load cases, in the order of [`coefficients`].
 pub const UNIT_CASES: [&str; 6] = [
@@ -512,10 +515,10 @@ pub fn rod_inertia_of(mass: &MeshMassProperties) -> crate::mechanism::RodInertia
 
 #[cfg(test)]
 mod tests {
-    use super::super::load::pin_load;
     use super::*;
     use crate::fem::mesh::structured::{TwoEyePlate, two_eye_plate};
     use crate::mechanism::{MechanismParams, rod_frame_cycle};
+    use crate::rod::pin_load::pin_load;
 
     const RHO: f64 = 7800.0;
 

@@ -13,21 +13,22 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use super::bores::{BoreSpec, BoreSurface, find_bores};
-use super::boundary::{boundary_faces, cross, norm};
-use super::element::QuadratureChoice;
-use super::error::{FemError, Result};
-use super::estimate::{ErrorEstimate, EstimateSummary, estimate_error};
-use super::load::{BoreLoad, SurfaceLoad, pin_load};
-use super::material::Material;
-use super::mesh::TetMesh;
-use super::recovery::recover_stress_cases;
-use super::statics::{
+use crate::fem::boundary::{boundary_faces, cross, norm};
+use crate::fem::element::QuadratureChoice;
+use crate::fem::error::{FemError, Result};
+use crate::fem::estimate::{ErrorEstimate, EstimateSummary, estimate_error};
+use crate::fem::load::SurfaceLoad;
+use crate::fem::material::Material;
+use crate::fem::mesh::TetMesh;
+use crate::fem::recovery::recover_stress_cases;
+use crate::fem::statics::{
     FactorisedSystem, StaticProblem, StaticSolution, Timings, solve_static, solve_static_reusing,
 };
-use super::stress::{
+use crate::fem::stress::{
     StressField, displacement_magnitudes, nodes_away_from, nodes_away_from_segments, peak_nodal,
     peak_unaveraged, stress_field,
 };
+use crate::rod::pin_load::{BoreLoad, pin_load};
 use std::sync::Arc;
 
 /// The default band around the fixed bore excluded from the judged stress measure: 6 mm.
@@ -70,7 +71,7 @@ pub struct RodOptions {
     /// The symbolic analysis of another solve of K's pattern (the same mesh with its boundary moved:
     /// the geometry check of [`super::smooth`]), reused where it fits.
     #[serde(skip)]
-    pub reuse_symbolic: Option<super::solver::SymbolicFactor>,
+    pub reuse_symbolic: Option<crate::fem::solver::SymbolicFactor>,
     /// The mesh given to [`solve_rod_on`] is the half z ≥ c of a mirror-symmetric rod, with its
     /// face on the plane z = c (m, rod frame); `None`: the whole rod.
     #[serde(default)]
@@ -363,8 +364,8 @@ pub struct RodSolution {
     /// Error estimates for fx and fy.
     pub estimates: [ErrorEstimate; 2],
     /// The buckling mode of the F_x case, when buckling was computed
-    /// ([`super::rod_buckling::rod_buckling`]; set by the caller, `None` from [`solve_rod_fields`]).
-    pub buckling: Option<super::buckling::BucklingMode>,
+    /// ([`super::buckling::rod_buckling`]; set by the caller, `None` from [`solve_rod_fields`]).
+    pub buckling: Option<crate::fem::buckling::BucklingMode>,
     /// The factorised K of the static cases, when [`RodOptions::keep_system`] asked for it.
     pub system: Option<Arc<FactorisedSystem>>,
     /// A half model's solution ([`solve_rod_on`]): for each node of the whole, the node of the
@@ -400,7 +401,7 @@ pub fn solve_rod_fields(
 
 /// [`solve_rod_fields`] on `mesh`, or, when `options` names a symmetry plane
 /// ([`RodOptions::mirror_plane_z_m`]), on the half model `mesh` is: solved with half the pin loads
-/// and u_z = 0 on the plane, then mirrored into the whole ([`super::mesh::mirror`]), on which the
+/// and u_z = 0 on the plane, then mirrored into the whole ([`crate::fem::mesh::mirror`]), on which the
 /// stresses, estimates and peaks are formed as for any mesh. Returns the mesh the solution is on
 /// (the whole, for a half model).
 pub fn solve_rod_on(
@@ -414,7 +415,7 @@ pub fn solve_rod_on(
         let solution = solve_rod_fields(&mesh, material, bores, force_n, options)?;
         return Ok((mesh, solution));
     };
-    let m = super::mesh::mirror::mirror(&mesh, c, mirror_plane_tolerance(&mesh))?;
+    let m = crate::fem::mesh::mirror::mirror(&mesh, c, mirror_plane_tolerance(&mesh))?;
     let held: Vec<usize> = m.plane_nodes.iter().map(|&n| 3 * n + 2).collect();
     let half = static_cases(&mesh, material, bores, force_n, options, 0.5, &held)?;
     let whole = mirrored_static(&m, half, bores)?;
@@ -444,7 +445,7 @@ pub fn mirror_plane_tolerance(mesh: &TetMesh) -> f64 {
 /// The static solution of a half model (`half`, on the half of `m`) as the whole's: the
 /// displacements mirrored, the loads and reactions of both halves, the bores found on the whole.
 fn mirrored_static<'a>(
-    m: &'a super::mesh::mirror::MirroredMesh,
+    m: &'a crate::fem::mesh::mirror::MirroredMesh,
     half: RodStatic<'_>,
     bores: &BoreSpec,
 ) -> Result<RodStatic<'a>> {
@@ -516,7 +517,7 @@ impl HalfModel {
     }
 
     /// The half model that was solved, out of the mirrored `whole` [`solve_rod_on`] returned: its
-    /// first nodes and elements ([`super::mesh::mirror::MirroredMesh::whole`] puts the images
+    /// first nodes and elements ([`crate::fem::mesh::mirror::MirroredMesh::whole`] puts the images
     /// after them).
     pub fn half_of(&self, whole: &TetMesh) -> Result<TetMesh> {
         TetMesh::new(
@@ -529,7 +530,7 @@ impl HalfModel {
 /// The first half of [`solve_rod_fields`]: the bores, the two pin loads and the static solution
 /// of both cases. What it does not read of `options` (the fixed band, the singular edges and their
 /// band, the fillet-kink count) [`rod_fields`] reads, so that a caller can work those out while K
-/// is factorised (on one thread, [`super::solver`]).
+/// is factorised (on one thread, [`crate::fem::solver`]).
 pub struct RodStatic<'a> {
     mesh: &'a TetMesh,
     material: Material,
@@ -817,7 +818,7 @@ pub fn rod_fields(st: RodStatic<'_>, options: &RodOptions) -> Result<RodSolution
 /// much.
 fn edge_band_warning(
     name: &str,
-    hidden: &super::stress::Peak,
+    hidden: &crate::fem::stress::Peak,
     judged_pa: f64,
     edges: &[[[f64; 3]; 2]],
     band: f64,
@@ -825,7 +826,7 @@ fn edge_band_warning(
 ) -> String {
     let d = edges
         .iter()
-        .map(|s| super::stress::point_segment_distance(hidden.location_m, *s))
+        .map(|s| crate::fem::stress::point_segment_distance(hidden.location_m, *s))
         .fold(f64::INFINITY, f64::min);
     let p = hidden.location_m.map(|v| v * 1e3);
     let advice = if exact_geometry {
@@ -877,7 +878,7 @@ fn bores_and_direction(
     let boundary = boundary_faces(mesh)?;
     let (loaded, fixed) = find_bores(mesh, &boundary, bores)?;
     let ab: [f64; 3] = std::array::from_fn(|j| bores.fixed_centre_m[j] - bores.loaded_centre_m[j]);
-    let along = super::boundary::dot(ab, axis);
+    let along = crate::fem::boundary::dot(ab, axis);
     let abp: [f64; 3] = std::array::from_fn(|j| ab[j] - along * axis[j]);
     let l = norm(abp);
     if l.is_nan() || l <= 0.0 {
@@ -919,11 +920,11 @@ pub fn rod_fx_case(mesh: &TetMesh, bores: &BoreSpec, force_n: f64) -> Result<Rod
     })
 }
 
-/// A rod's mesh must be one piece ([`super::mesh::pieces`]): a piece apart from the one that
+/// A rod's mesh must be one piece ([`crate::fem::mesh::pieces`]): a piece apart from the one that
 /// holds the fixed bore has no support (K singular), so it is refused by where it is and how
 /// large it is, not reported later as a failed pivot.
 fn check_one_piece(mesh: &TetMesh, fixed_nodes: &[usize]) -> Result<()> {
-    let (pieces, labels) = super::mesh::pieces::pieces(mesh);
+    let (pieces, labels) = crate::fem::mesh::pieces::pieces(mesh);
     if pieces.len() < 2 {
         return Ok(());
     }
@@ -963,7 +964,7 @@ mod tests {
     /// few facets (a STEP settles it); on a STEP the edge is sharp in the B-rep.
     #[test]
     fn the_edge_band_warning_fits_stl_and_step() {
-        let hidden = super::super::stress::Peak {
+        let hidden = crate::fem::stress::Peak {
             value: 120e6,
             node: 0,
             element: None,
@@ -989,8 +990,9 @@ mod tests {
     /// same loads) the displacements, peaks, reactions and estimates agree to round-off.
     #[test]
     fn a_half_model_mirrored_is_the_whole_model() {
+        use crate::fem::Material;
         use crate::fem::mesh::structured::{TwoEyePlate, two_eye_plate};
-        use crate::fem::{BoreSpec, Material};
+        use crate::rod::BoreSpec;
         // the upper half of a 40 mm plate, z ∈ [0, 20] mm, two layers
         let p = TwoEyePlate {
             thickness: 0.02,

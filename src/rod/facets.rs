@@ -35,7 +35,7 @@ use std::collections::HashMap;
 use nalgebra::Vector3;
 
 use super::segment_grid::SegmentGrid;
-use super::stress::point_segment_distance;
+use crate::fem::stress::point_segment_distance;
 
 /// Dihedral angle below which two facets count as coplanar (a subdivided flat face), degrees.
 pub const FLAT_DEG: f64 = 0.5;

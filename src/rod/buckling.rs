@@ -1,22 +1,22 @@
-//! Linear buckling of the rod: the F_x case of stage 3 ([`super::rod::rod_fx_case`]:
+//! Linear buckling of the rod: the F_x case of stage 3 ([`super::solve::rod_fx_case`]:
 //! bore B fixed, the pin force on bore A towards B, a compression) handed to the general
-//! eigen-solver of [`super::buckling`].
+//! eigen-solver of [`crate::fem::buckling`].
 
 use super::bores::BoreSpec;
-use super::buckling::{
+use super::solve::rod_fx_case;
+use crate::fem::buckling::{
     BucklingOptions, BucklingProblem, BucklingSolution, solve_buckling, solve_buckling_with,
 };
-use super::element::QuadratureChoice;
-use super::error::Result;
-use super::material::Material;
-use super::mesh::TetMesh;
-use super::rod::rod_fx_case;
-use super::statics::FactorisedSystem;
+use crate::fem::element::QuadratureChoice;
+use crate::fem::error::Result;
+use crate::fem::material::Material;
+use crate::fem::mesh::TetMesh;
+use crate::fem::statics::FactorisedSystem;
 
 /// Linear buckling of a rod under the compressive F_x case of stage 3 ([`rod_fx_case`]): bore B
 /// fixed, bore A loaded by the pin load of resultant `compression_n` along A→B (towards the
 /// fixed bore: compression). λ₁ · `compression_n` is the linear buckling load. `system`: the
-/// factorised K of stage 3's static cases on this mesh ([`super::rod::RodOptions::keep_system`]),
+/// factorised K of stage 3's static cases on this mesh ([`super::solve::RodOptions::keep_system`]),
 /// used instead of assembling and factorising K again (the same supports, so the same K).
 pub fn rod_buckling(
     mesh: &TetMesh,
@@ -45,7 +45,7 @@ pub fn rod_buckling(
 mod tests {
     use super::*;
     use crate::fem::mesh::structured::{TwoEyePlate, two_eye_plate};
-    use crate::fem::rod::{RodOptions, solve_rod_fields};
+    use crate::rod::solve::{RodOptions, solve_rod_fields};
 
     /// The factorised K of stage 3's static cases is the buckling case's K (the same supports):
     /// reusing it gives the same load factor to the bit; a system with other supports is refused.

@@ -24,7 +24,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::material::von_mises;
+use crate::fem::material::von_mises;
 
 /// The mean-stress correction of the fatigue safety factor.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]

@@ -6,9 +6,9 @@
 //!
 //! 1. mesh (uniform at the initial size, then from a size map capped at the largest size), solve
 //!    both load cases with one
-//!    factorisation ([`super::rod`]), recover σ* and estimate ([`super::estimate`]);
+//!    factorisation ([`super::solve`]), recover σ* and estimate ([`crate::fem::estimate`]);
 //! 2. the peak's estimated error: on the first mesh the single-mesh bound (the largest pointwise
-//!    indicator near the peak, [`super::estimate`]); from the second on, Richardson
+//!    indicator near the peak, [`crate::fem::estimate`]); from the second on, Richardson
 //!    extrapolation over the sequence,
 //!    e_k = |P_k − P_{k−1}| / ((r^q − 1) P_k), r = h_{k−1} / h_k the ratio of the local element
 //!    sizes at the peak and q the order: 2 (the stress of quadratic elements, and the chord error
@@ -48,15 +48,15 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use super::bores::BoreSpec;
-use super::error::{FemError, Result};
-use super::material::Material;
-use super::mesh::{TetMesh, dist};
-use super::recovery::node_elements;
-use super::rod::{
+use super::solve::{
     AdaptiveStep, DEFAULT_FIXED_BAND_M, MeshPhases, RodOptions, RodSolution, StepTimings,
     solve_rod_on,
 };
-use super::shape::TET10_EDGES;
+use crate::fem::error::{FemError, Result};
+use crate::fem::material::Material;
+use crate::fem::mesh::{TetMesh, dist};
+use crate::fem::recovery::node_elements;
+use crate::fem::shape::TET10_EDGES;
 
 /// Settings of the adaptive loop.
 #[derive(Clone, Debug, Serialize, Deserialize)]

@@ -4,7 +4,7 @@
 
 use std::collections::HashMap;
 
-use super::stress::point_segment_distance;
+use crate::fem::stress::point_segment_distance;
 
 /// Segments in a grid of cells of side `cell`.
 #[derive(Clone, Debug, Default)]
