@@ -443,7 +443,7 @@ fn buckling_on(
     })
 }
 
-/// The buckling mode of a rod, for the report's VTU file.
+/// The first buckling mode of a body and its load factor.
 #[derive(Clone, Debug)]
 pub struct BucklingMode {
     /// λ₁.

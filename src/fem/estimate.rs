@@ -13,10 +13,10 @@
 //!   |σ_vM(σ*) − σ_vM(σ_h)| ≤ σ_vM(σ* − σ_h). The element indicator is the largest
 //!   σ_vM(σ* − σ_h^e) over the element's ten nodes, with σ_h^e the element's own (unaveraged)
 //!   stress: a bound of how far the element's von Mises stress is from the recovered one, in Pa.
-//!   It drives the mesh sizes of the adaptive loop ([`super::adapt`]).
+//!   It drives the mesh sizes of an adaptive loop ([`crate::rod::adapt`]).
 //! * **The peak** (the quantity the criterion judges): P_h = max of the nodally averaged
-//!   von Mises stress over the nodes outside the band around the fixed bore; P* the same
-//!   maximum of σ_vM(σ*). The recovery estimate of its error is |P* − P_h| / P_h. It is blind to
+//!   von Mises stress over the nodes of a mask (the judged region); P* the same maximum of
+//!   σ_vM(σ*). The recovery estimate of its error is |P* − P_h| / P_h. It is blind to
 //!   what the patches cannot see, above all a fillet that the straight-sided elements facet
 //!   coarsely (design 1 at 6 mm: P* agrees with P_h to 0.1 % while both are 14 % below the
 //!   converged peak). On a single mesh the reported estimate is therefore the **local bound**:
@@ -65,7 +65,7 @@ pub struct ErrorEstimate {
 /// The scalar figures of an [`ErrorEstimate`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct EstimateSummary {
-    /// ZZ energy-norm relative error η / (‖σ*‖² + η²)^½ over the whole rod.
+    /// ZZ energy-norm relative error η / (‖σ*‖² + η²)^½ over the whole body.
     pub energy_error_rel: f64,
     /// P_h: max nodally averaged von Mises outside the fixed band, MPa.
     pub peak_mpa: f64,
@@ -89,7 +89,7 @@ impl EstimateSummary {
 }
 
 /// Estimates the error of the solution `u` with stresses `field` and recovered stress `rec`;
-/// `mask` marks the nodes outside the band around the fixed bore (where the peak is taken).
+/// `mask` marks the nodes where the peak is taken (the judged region).
 pub fn estimate_error(
     mesh: &TetMesh,
     material: &Material,

@@ -98,7 +98,7 @@ pub fn uniform_traction_with_resultant(
 /// unit direction `axis`) whose resultant is `resultant` (N, perpendicular to the axis).
 ///
 /// At a point x of the wall let e_r be the unit radial direction from the axis, d̂ = F/|F| and
-/// ê = â × d̂; c = e_r · d̂ = cos θ, s = e_r · ê = sin θ. The traction on the rod is the pressure
+/// ê = â × d̂; c = e_r · d̂ = cos θ, s = e_r · ê = sin θ. The traction on the body is the pressure
 /// pushing the wall outward, t = p e_r, with
 ///
 /// p = α c + β c s for c > 0, p = 0 elsewhere,

@@ -1,21 +1,21 @@
-//! Stage 3 of rodstudy: static linear-elastic FEM of a rod with 10-node tetrahedra (SPEC "Stage 3 —
-//! FEM", thesis §5.3, which used NX Nastran CTETRA(10) at 5 mm).
+//! The tet10 kernel: static linear elasticity with 10-node tetrahedra, knowing nothing of what the
+//! body is (the rod problem on it is [`crate::rod`]).
 //!
-//! Pipeline: STL → `pipeline/mesh_rod.py` (gmsh, straight-sided tetra10) → [`TetMesh`] (metres) →
-//! boundary faces → bores found on the geometry ([`bores`]) → consistent nodal forces of a uniform
-//! bore traction ([`load`]) → parallel assembly ([`assembly`]) → sparse Cholesky (faer, [`solver`],
-//! in a nested-dissection order, [`ordering`]), both load cases (F_x, F_y) from one factorisation → stresses at the element nodes, unaveraged and
-//! nodally averaged ([`stress`]) → figures ([`rod::FemResult`]) and fields ([`rod::RodSolution`]);
-//! the meshes come from [`crate::mesher`], the ParaView files and pictures are written by
-//! [`crate::report`]: nothing here opens a file.
+//! Pipeline: [`TetMesh`] (metres) → boundary faces ([`boundary`]) → consistent nodal forces of
+//! surface tractions and body forces ([`load`], [`body_force`]) → parallel assembly ([`assembly`])
+//! → sparse Cholesky (faer, [`solver`], in a nested-dissection order, [`ordering`]), several load
+//! cases from one factorisation ([`statics`]) → stresses at the element nodes, unaveraged and
+//! nodally averaged ([`stress`], [`nodal_stress`]) → superconvergent recovery ([`recovery`]) and
+//! the error estimates ([`estimate`]); linear buckling on the geometric stiffness ([`buckling`],
+//! [`geometric_stiffness`]). Nothing here opens a file.
 //!
 //! Cost: the sparse Cholesky factorisation dominates (about half the analysis of a rod; design 1 at
-//! 4 mm, 169 kDOF: factor 88 M entries, 2.3 s); the symbolic analysis ([`solver::SymbolicFactor`]) is kept and
-//! can be reused for any matrix with the same pattern (same mesh and supports, e.g. another
-//! material); load cases share one numeric factorisation. Results are linear in the force.
+//! 4 mm, 169 kDOF: factor 88 M entries, 2.3 s); the symbolic analysis ([`solver::SymbolicFactor`])
+//! is kept and can be reused for any matrix with the same pattern (same mesh and supports, e.g.
+//! another material); load cases share one numeric factorisation. Results are linear in the force.
 //!
-//! Conventions: SI inside (m, N, Pa); millimetres only at the edges (mesh files, reports). Tetra10
-//! node order: VTK's (see [`shape`]). Stress/strain components `[xx, yy, zz, xy, yz, zx]`.
+//! Conventions: SI inside (m, N, Pa). Tetra10 node order: VTK's (see [`shape`]). Stress/strain
+//! components `[xx, yy, zz, xy, yz, zx]`.
 //!
 //! References: O. C. Zienkiewicz, R. L. Taylor, J. Z. Zhu, *The Finite Element Method: Its Basis and
 //! Fundamentals*, 7th ed. (tetra10 shape functions, consistent loads, patch test); T. J. R. Hughes,

@@ -21,7 +21,7 @@
 //! element's own quadratic shape functions.
 //!
 //! Boundary nodes are fitted by their one-sided patch, extrapolating the polynomial to the
-//! surface: that is where rod stresses peak, and the quadratic fit is what makes the recovered
+//! surface: that is where stresses usually peak, and the quadratic fit is what makes the recovered
 //! surface stress better than the nodal average of σ_h (which is a weighted mean of values
 //! inside the elements and so lags behind a steep gradient).
 

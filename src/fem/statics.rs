@@ -80,7 +80,7 @@ pub struct StaticSolution {
 }
 
 /// The factorised stiffness of a static solve, kept for another analysis on the same mesh,
-/// material, quadrature and supports (the buckling case of the rod: [`super::buckling`]), which
+/// material, quadrature and supports (a buckling analysis: [`super::buckling`]), which
 /// then needs neither the assembly nor the factorisation again.
 #[derive(Debug)]
 pub struct FactorisedSystem {

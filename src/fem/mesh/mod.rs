@@ -1,5 +1,5 @@
 //! The quadratic tetrahedral mesh (SI: metres), and structured meshes made in Rust for
-//! verification ([`structured`]); meshes of a rod come from [`crate::mesher`].
+//! verification ([`structured`]); meshes of parts come from [`crate::mesher`].
 //!
 //! Element node order: VTK's tetra10 (see [`crate::fem::shape`]).
 

@@ -1,6 +1,6 @@
-//! The connected pieces of a mesh: elements that share a node belong to one piece. A rod's
-//! analysis needs one piece; a second one (a stray body in the STL, a bolt or a cap that does
-//! not share nodes with the rod) has no support and would make K singular, which the
+//! The connected pieces of a mesh: elements that share a node belong to one piece. A supported
+//! body's analysis needs one piece; a second one (a stray body in the file, or a part that only
+//! touches it without sharing nodes) has no support and would make K singular, which the
 //! factorisation reports only as a failed pivot. Found by union–find over the elements' nodes
 //! (Tarjan, "Efficiency of a good but not linear set union algorithm", JACM 1975).
 
