@@ -107,8 +107,8 @@ fn the_stress_does_not_depend_on_units_or_pose() {
     for name in ["m", "in", "m_moved", "mm_moved"] {
         let v = fem(dir.path(), name, &config, &mode);
         for (a, b, case) in [
-            (&base.fem.fx, &v.fem.fx, "fx"),
-            (&base.fem.fy, &v.fem.fy, "fy"),
+            (&base.fem.cases["fx"], &v.fem.cases["fx"], "fx"),
+            (&base.fem.cases["fy"], &v.fem.cases["fy"], "fy"),
         ] {
             let (sa, sb) = (
                 a.max_von_mises_away_from_fixed_mpa,
@@ -178,12 +178,10 @@ fn adaptive_peak_reaches_the_converged_reference_of_the_fillet_rod() {
         .collect();
     // the target holds for the governing case (F_y here); the smaller case's error need only be
     // as small in MPa (3 % of the governing peak)
-    let governing = r
-        .fem
-        .fx
+    let governing = r.fem.cases["fx"]
         .max_von_mises_away_from_fixed_mpa
-        .max(r.fem.fy.max_von_mises_away_from_fixed_mpa);
-    for (case, got) in [("fx", &r.fem.fx), ("fy", &r.fem.fy)] {
+        .max(r.fem.cases["fy"].max_von_mises_away_from_fixed_mpa);
+    for (case, got) in [("fx", &r.fem.cases["fx"]), ("fy", &r.fem.cases["fy"])] {
         let p: Vec<f64> = data[case]
             .as_array()
             .unwrap()
@@ -264,8 +262,8 @@ fn a_finer_export_of_the_same_surface_gives_the_same_stress() {
         "{meshed_f} vs {meshed_c}"
     );
     for (a, b, case) in [
-        (&coarse.fem.fx, &finer.fem.fx, "fx"),
-        (&coarse.fem.fy, &finer.fem.fy, "fy"),
+        (&coarse.fem.cases["fx"], &finer.fem.cases["fx"], "fx"),
+        (&coarse.fem.cases["fy"], &finer.fem.cases["fy"], "fy"),
     ] {
         let (sa, sb) = (
             a.max_von_mises_away_from_fixed_mpa,
@@ -324,7 +322,7 @@ fn the_geometry_error_of_a_coarse_cad_export_is_estimated_honestly() {
     let work = dir.path().join("work");
     let r = adaptive_record(&stl, force, &config, &work);
     let last = r.mesh.adaptive.as_ref().unwrap().iterations - 1;
-    let size = r.fem.fy.adaptive.last().unwrap().size_at_peak_mm;
+    let size = r.fem.cases["fy"].adaptive.last().unwrap().size_at_peak_mm;
     assert!(size < 2.5, "F_y: {size} mm elements at the peak");
     // the truth of the geometry part: the same mesh on the exact geometry
     let exact = dir.path().join("on_the_brep.vtu");
@@ -345,8 +343,8 @@ fn the_geometry_error_of_a_coarse_cad_export_is_estimated_honestly() {
     .record;
     let reference = 385.58; // F_y, see tests/step_input.rs (curved_tet10_on_the_step_fillet_rod)
     for (case, got, truth) in [
-        ("fy", &r.fem.fy, &on_brep.fem.fy),
-        ("fx", &r.fem.fx, &on_brep.fem.fx),
+        ("fy", &r.fem.cases["fy"], &on_brep.fem.cases["fy"]),
+        ("fx", &r.fem.cases["fx"], &on_brep.fem.cases["fx"]),
     ] {
         let p = got.max_von_mises_away_from_fixed_mpa;
         let g = got.estimated_geometry_error_rel.unwrap();
@@ -449,8 +447,7 @@ fn designs_4_and_5_converge_honestly_against_their_exact_geometry() {
         eprintln!(
             "{id}: {:?}, meshes (DOFs, F_y peak MPa, size at it mm): {:?}",
             adaptive.stop,
-            r.fem
-                .fy
+            r.fem.cases["fy"]
                 .adaptive
                 .iter()
                 .map(|s| (s.dofs, s.peak_mpa, s.size_at_peak_mm))
@@ -462,7 +459,7 @@ fn designs_4_and_5_converge_honestly_against_their_exact_geometry() {
             rodstudy::rod::adapt::StopReason::Converged,
             "{id}"
         );
-        for (case, got) in [("fx", &r.fem.fx), ("fy", &r.fem.fy)] {
+        for (case, got) in [("fx", &r.fem.cases["fx"]), ("fy", &r.fem.cases["fy"])] {
             let peak = got.max_von_mises_away_from_fixed_mpa;
             let est = got.estimated_error_rel;
             let (true_error, reference, unc) = against_reference(&refs, id, case, peak);
@@ -480,7 +477,7 @@ fn designs_4_and_5_converge_honestly_against_their_exact_geometry() {
                 "{id} {case}: true {true_error} vs estimated {est}"
             );
         }
-        let fy = &r.fem.fy;
+        let fy = &r.fem.cases["fy"];
         assert!(fy.estimated_discretisation_error_rel <= 0.03, "{id}");
     }
 }

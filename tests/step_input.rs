@@ -424,8 +424,8 @@ fn curved_tet10_on_the_step_fillet_rod() {
     .record;
     assert!(r.mesh.source.contains("STEP"), "{}", r.mesh.source);
     for (case, c, reference, uncertainty) in [
-        ("fy", &r.fem.fy, ref_fy, unc_fy),
-        ("fx", &r.fem.fx, ref_fx, unc_fx),
+        ("fy", &r.fem.cases["fy"], ref_fy, unc_fy),
+        ("fx", &r.fem.cases["fx"], ref_fx, unc_fx),
     ] {
         let truth = ((c.max_von_mises_away_from_fixed_mpa - reference).abs() - uncertainty)
             .max(0.0)
@@ -469,8 +469,8 @@ fn curved_tet10_on_the_step_fillet_rod() {
     .unwrap()
     .record;
     for (case, c, step, reference, uncertainty) in [
-        ("fy", &s.fem.fy, &r.fem.fy, ref_fy, unc_fy),
-        ("fx", &s.fem.fx, &r.fem.fx, ref_fx, unc_fx),
+        ("fy", &s.fem.cases["fy"], &r.fem.cases["fy"], ref_fy, unc_fy),
+        ("fx", &s.fem.cases["fx"], &r.fem.cases["fx"], ref_fx, unc_fx),
     ] {
         let (p, q) = (
             c.max_von_mises_away_from_fixed_mpa,
@@ -530,7 +530,7 @@ fn a_small_fillet_cut_into_45_degree_facets_is_refined_not_excluded() {
             .record
     };
     let chord = run("stepped_chord", &adaptive);
-    let fx = &chord.fem.fx;
+    let fx = &chord.fem.cases["fx"];
     let at = fx.max_von_mises_away_from_fixed_at_mm;
     let (d, g) = (
         fx.estimated_discretisation_error_rel,
@@ -560,14 +560,14 @@ fn a_small_fillet_cut_into_45_degree_facets_is_refined_not_excluded() {
     let fine = run("stepped_fine", &adaptive);
     let (p, q) = (
         fx.max_von_mises_away_from_fixed_mpa,
-        fine.fem.fx.max_von_mises_away_from_fixed_mpa,
+        fine.fem.cases["fx"].max_von_mises_away_from_fixed_mpa,
     );
     println!(
         "stepped_fine: F_x {q:.2} MPa ± {:.1} %",
-        100.0 * fine.fem.fx.estimated_error_rel
+        100.0 * fine.fem.cases["fx"].estimated_error_rel
     );
     assert!(
-        (p - q).abs() <= fx.estimated_error_rel * p + fine.fem.fx.estimated_error_rel * q,
+        (p - q).abs() <= fx.estimated_error_rel * p + fine.fem.cases["fx"].estimated_error_rel * q,
         "F_x {p} against the fine export's {q}"
     );
     let plain = run("plain_coarse", &MeshMode::Fixed(5.0));

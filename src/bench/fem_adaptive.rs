@@ -1,7 +1,7 @@
 //! Benchmark of stage 3's adaptive loop: where each design's time goes, per
 //! iteration and phase. Each design runs `rodstudy fem DESIGN --json --no-pictures` in its own
 //! process, cold, as a user runs it; the per-iteration phases come from its record
-//! (`fx.adaptive[k].timings`, [`crate::rod::solve::StepTimings`]): the mesh (gmsh, with the STL's
+//! (`fx.adaptive[k].timings`, [`crate::rod::records::StepTimings`]): the mesh (gmsh, with the STL's
 //! classification on the first), the analysis (assembly, symbolic analysis, factorisation, solves,
 //! stresses with recovery and error estimate) and the rest (sizing the next mesh). The shares are
 //! against the loop's own total, so they travel between machines better than the seconds. Where
@@ -16,7 +16,7 @@ use std::time::Instant;
 use anyhow::{Result, bail};
 use serde::{Deserialize, Serialize};
 
-use crate::rod::solve::MeshPhases;
+use crate::rod::records::MeshPhases;
 
 /// One iteration of one design.
 #[derive(Clone, Debug, Serialize, Deserialize)]

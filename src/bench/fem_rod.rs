@@ -10,7 +10,8 @@ use crate::fem::error::Result;
 use crate::fem::material::Material;
 use crate::mesher::{MeshReport, mesh_stl};
 use crate::rod::bores::BoreSpec;
-use crate::rod::solve::{FemResult, RodOptions, solve_rod};
+use crate::rod::records::FemResult;
+use crate::rod::solve::{RodOptions, solve_rod};
 
 /// What [`bench_rod`] measures.
 #[derive(Clone, Debug, Serialize, Deserialize)]

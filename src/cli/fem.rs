@@ -191,8 +191,9 @@ struct FemJson<'a> {
     elements: usize,
     nodes: usize,
     force_n: f64,
-    fx: &'a crate::rod::LoadCaseResult,
-    fy: &'a crate::rod::LoadCaseResult,
+    /// The load cases, one field per case named by it (`fx`, `fy`).
+    #[serde(flatten)]
+    cases: &'a crate::rod::LoadCases,
     mesh: &'a crate::stages::records::MeshSummary,
     criterion: &'a crate::stages::records::StressVerdict,
     fem: &'a crate::rod::FemResult,
@@ -218,8 +219,7 @@ impl<'a> From<&'a DesignFem> for FemJson<'a> {
             elements: d.fem.elements,
             nodes: d.fem.nodes,
             force_n: d.force_n,
-            fx: &d.fem.fx,
-            fy: &d.fem.fy,
+            cases: &d.fem.cases,
             mesh: &d.mesh,
             criterion: &d.criterion,
             fem: &d.fem,
@@ -261,7 +261,7 @@ fn print_result(d: &DesignFem) {
     outln!(
         "\n| case | max von Mises unaveraged [MPa] | averaged [MPa] | away from fixed bore [MPa] (judged) | max displacement [mm] | resultant error | reaction balance |\n|---|---|---|---|---|---|---|"
     );
-    for c in [&f.fx, &f.fy] {
+    for c in f.cases.iter() {
         outln!(
             "| {} | {:.2} | {:.2} | {:.2} ± {:.1} % | {:.4} | {:.1e} | {:.1e} |",
             c.name,
@@ -287,7 +287,7 @@ fn print_result(d: &DesignFem) {
         outln!(
             "\n| case | iteration | elements | DOFs | peak [MPa] | size at peak [mm] | order | estimated error | wall [s] |\n|---|---|---|---|---|---|---|---|---|"
         );
-        for c in [&f.fx, &f.fy] {
+        for c in f.cases.iter() {
             for s in &c.adaptive {
                 outln!(
                     "| {} | {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} % | {:.1} |",
@@ -306,7 +306,7 @@ fn print_result(d: &DesignFem) {
     }
     let t = &f.timings;
     outln!(
-        "\ntimes [s]: assembly {:.2}, symbolic analysis {:.2}, factorisation {:.2}, solve (both cases) {:.2}, stress {:.2}; total {:.2}",
+        "\ntimes [s]: assembly {:.2}, symbolic analysis {:.2}, factorisation {:.2}, solve (all cases) {:.2}, stress {:.2}; total {:.2}",
         t.assembly_s,
         t.symbolic_s,
         t.factorisation_s,
@@ -326,7 +326,7 @@ fn print_result(d: &DesignFem) {
     for note in &v.model_validity {
         outln!("model validity: {note}");
     }
-    for c in [&f.fx, &f.fy] {
+    for c in f.cases.iter() {
         if let Some(vtu) = &c.vtu {
             eprintln!("wrote {}", vtu.display());
         }
@@ -357,30 +357,44 @@ fn refine(
             " (both cases)"
         }
     );
+    let labels: Vec<&str> = crate::rod::cases::STATIC_CASES
+        .iter()
+        .map(|c| c.label)
+        .collect();
+    let per_case: String = labels
+        .iter()
+        .map(|l| format!(" {l} unaveraged / averaged / away [MPa] |"))
+        .collect();
+    let all = labels.join(" / ");
+    let columns = 9 + labels.len();
     outln!(
-        "| size [mm] | elements | DOFs | F_x unaveraged / averaged / away [MPa] | F_y unaveraged / averaged / away [MPa] | F_y max displ. [mm] | F_x / F_y recovered peak [MPa] | F_x / F_y est. error | F_x / F_y bound at peak | F_x / F_y energy error | mesh [s] | solve [s] |\n|---|---|---|---|---|---|---|---|---|---|---|---|"
+        "| size [mm] | elements | DOFs |{per_case} {all} max displ. [mm] | {all} recovered peak [MPa] | {all} est. error | {all} bound at peak | {all} energy error | mesh [s] | solve [s] |\n|{}",
+        "---|".repeat(columns)
     );
     for l in &study.levels {
+        let joined = |f: &dyn Fn(&crate::rod::refinement::CaseMeasures) -> String| {
+            l.cases.iter().map(f).collect::<Vec<_>>().join(" / ")
+        };
+        let per_case: String = l
+            .cases
+            .iter()
+            .map(|c| {
+                format!(
+                    " {:.1} / {:.1} / {:.1} |",
+                    c.max_unaveraged_mpa, c.max_averaged_mpa, c.max_away_from_fixed_mpa
+                )
+            })
+            .collect();
         outln!(
-            "| {} | {} | {} | {:.1} / {:.1} / {:.1} | {:.1} / {:.1} / {:.1} | {:.4} | {:.1} / {:.1} | {:.3} / {:.3} | {:.3} / {:.3} | {:.3} / {:.3} | {:.1} | {:.2} |",
+            "| {} | {} | {} |{per_case} {} | {} | {} | {} | {} | {:.1} | {:.2} |",
             l.size_mm,
             l.elements,
             l.dofs,
-            l.fx.max_unaveraged_mpa,
-            l.fx.max_averaged_mpa,
-            l.fx.max_away_from_fixed_mpa,
-            l.fy.max_unaveraged_mpa,
-            l.fy.max_averaged_mpa,
-            l.fy.max_away_from_fixed_mpa,
-            l.fy.max_displacement_mm,
-            l.fx.error_estimate.recovered_peak_mpa,
-            l.fy.error_estimate.recovered_peak_mpa,
-            l.fx.estimated_error_rel,
-            l.fy.estimated_error_rel,
-            l.fx.error_estimate.peak_node_bound_rel,
-            l.fy.error_estimate.peak_node_bound_rel,
-            l.fx.error_estimate.energy_error_rel,
-            l.fy.error_estimate.energy_error_rel,
+            joined(&|c| format!("{:.4}", c.max_displacement_mm)),
+            joined(&|c| format!("{:.1}", c.error_estimate.recovered_peak_mpa)),
+            joined(&|c| format!("{:.3}", c.estimated_error_rel)),
+            joined(&|c| format!("{:.3}", c.error_estimate.peak_node_bound_rel)),
+            joined(&|c| format!("{:.3}", c.error_estimate.energy_error_rel)),
             l.mesh_s,
             l.solve_total_s
         );

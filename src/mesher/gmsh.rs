@@ -17,7 +17,7 @@ use serde::{Deserialize, Serialize};
 use super::rodmesh::read_rodmesh;
 use crate::fem::TetMesh;
 use crate::fem::error::{FemError, Result};
-use crate::rod::solve::MeshPhases;
+use crate::rod::records::MeshPhases;
 
 /// What the mesher reports (quality figures from gmsh's `getElementQualities`).
 #[derive(Clone, Debug, Serialize, Deserialize)]

@@ -13,7 +13,7 @@ use super::size_field::write_size_field;
 use crate::fem::error::{FemError, Result};
 use crate::fem::mesh::TetMesh;
 use crate::rod::adapt::{MeshAsk, Mesher};
-use crate::rod::solve::MeshPhases;
+use crate::rod::records::MeshPhases;
 
 /// gmsh on one rod: its surface (an STL in millimetres, in the rod frame), or the exact geometry
 /// of its STEP file moved into the rod frame.

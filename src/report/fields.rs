@@ -15,7 +15,8 @@ use crate::fem::stress::StressField;
 use crate::report::picture::{PictureOptions, render_tet10_field};
 use crate::rod::BoreSurface;
 use crate::rod::cycle::{CycleSolution, UnitSolutions};
-use crate::rod::solve::{FemResult, LoadCaseResult, RodSolution};
+use crate::rod::records::{FemResult, LoadCaseResult};
+use crate::rod::solve::RodSolution;
 use crate::stages::records::DesignCycle;
 use std::path::{Path, PathBuf};
 
@@ -118,12 +119,19 @@ fn write_fem_files(
     std::fs::create_dir_all(dir).map_err(|e| FemError::io(dir, e))?;
     let vtus = which != FemFiles::Pictures;
     let pictures = which != FemFiles::Vtu;
-    let cases = [&result.fx, &result.fy];
-    let vtu_paths = cases.map(|c| dir.join(format!("{stem}_{}.vtu", c.name)));
-    let picture_paths = cases.map(|c| dir.join(format!("von_mises_{}.svg", c.name)));
+    let vtu_paths: Vec<PathBuf> = result
+        .cases
+        .iter()
+        .map(|c| dir.join(format!("{stem}_{}.vtu", c.name)))
+        .collect();
+    let picture_paths: Vec<PathBuf> = result
+        .cases
+        .iter()
+        .map(|c| dir.join(format!("von_mises_{}.svg", c.name)))
+        .collect();
     type Task<'a> = Box<dyn FnOnce() -> Result<()> + Send + 'a>;
     let mut tasks: Vec<Task> = Vec::new();
-    for c in 0..2 {
+    for (c, case) in result.cases.iter().enumerate() {
         if vtus {
             let path = &vtu_paths[c];
             tasks.push(Box::new(move || {
@@ -140,7 +148,7 @@ fn write_fem_files(
             }));
         }
         if pictures {
-            let (path, case) = (&picture_paths[c], cases[c]);
+            let path = &picture_paths[c];
             tasks.push(Box::new(move || {
                 write_case_picture(path, mesh, &solution.stresses[c], case)
             }));
@@ -152,15 +160,13 @@ fn write_fem_files(
         }));
     }
     tasks.into_par_iter().map(|t| t()).collect::<Result<()>>()?;
-    let [vfx, vfy] = vtu_paths;
-    let [pfx, pfy] = picture_paths;
-    if vtus {
-        result.fx.vtu = Some(vfx);
-        result.fy.vtu = Some(vfy);
-    }
-    if pictures {
-        result.fx.picture = Some(pfx);
-        result.fy.picture = Some(pfy);
+    for ((case, vtu), picture) in result.cases.iter_mut().zip(vtu_paths).zip(picture_paths) {
+        if vtus {
+            case.vtu = Some(vtu);
+        }
+        if pictures {
+            case.picture = Some(picture);
+        }
     }
     Ok(())
 }
@@ -180,7 +186,7 @@ fn write_case_picture(
         .map(|v| v * 1e-6)
         .collect();
     let peak = case.max_von_mises_away_from_fixed_mpa;
-    let label = if case.name == "fx" { "F_x" } else { "F_y" };
+    let label = crate::rod::cases::label(&case.name);
     let svg = render_tet10_field(
         mesh,
         &values,

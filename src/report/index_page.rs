@@ -225,8 +225,12 @@ fn design_section(s: &mut String, r: &RankRow, out: &Path) {
             "error of the judged peaks",
             format!(
                 "{}{}",
-                [&f.fem.fy, &f.fem.fx].map(ranking::error_split).join("; "),
-                if f.fem.fy.smooth_surface_peak_mpa.is_some() {
+                ranking::error_splits(&f.fem),
+                if f.fem
+                    .cases
+                    .iter()
+                    .any(|c| c.smooth_surface_peak_mpa.is_some())
+                {
                     "; a STEP export of the design removes the geometry part"
                 } else {
                     ""
@@ -308,7 +312,7 @@ fn design_section(s: &mut String, r: &RankRow, out: &Path) {
         ),
     );
     if let Some(f) = r.fem {
-        for case in [&f.fem.fx, &f.fem.fy] {
+        for case in f.fem.cases.iter() {
             let p = case.max_von_mises_away_from_fixed_at_mm;
             image(
                 s,
@@ -316,7 +320,7 @@ fn design_section(s: &mut String, r: &RankRow, out: &Path) {
                 &format!("{dir}/von_mises_{}.svg", case.name),
                 &format!(
                     "von Mises, {} case (F = {:.0} N): peak {:.1} MPa ± {:.1} % at ({:.1}, {:.1}, {:.1}) mm in the rod frame (A at the origin, x towards B); grey: above the peak, at the fixed bore or a sharp edge (singular, not judged)",
-                    if case.name == "fx" { "F_x" } else { "F_y" },
+                    crate::rod::cases::label(&case.name),
                     case.force_n,
                     case.max_von_mises_away_from_fixed_mpa,
                     100.0 * case.estimated_error_rel,

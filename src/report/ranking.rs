@@ -245,8 +245,8 @@ pub fn csv(results: &StudyResults) -> Result<Vec<u8>> {
     for r in ranking(results) {
         let f = r.fem;
         let d = r.dynamics;
-        let fx = f.map(|f| &f.fem.fx);
-        let fy = f.map(|f| &f.fem.fy);
+        let fx = f.and_then(|f| f.fem.cases.get("fx"));
+        let fy = f.and_then(|f| f.fem.cases.get("fy"));
         w.serialize(CsvRow {
             rank: r.rank,
             design: &r.mass.design,
@@ -274,12 +274,7 @@ pub fn csv(results: &StudyResults) -> Result<Vec<u8>> {
             cycle_crank_angle_of_max_deg: r.cycle.map(|c| c.crank_angle_of_max_deg),
             fatigue_safety_factor: r.cycle.map(|c| c.fatigue_safety_factor),
             buckling_load_factor: buckling.then(|| f.and_then(|f| f.buckling_load_factor)),
-            max_displacement_mm: f.map(|f| {
-                f.fem
-                    .fx
-                    .max_displacement_mm
-                    .max(f.fem.fy.max_displacement_mm)
-            }),
+            max_displacement_mm: f.map(|f| f.fem.cases.max_of(|c| c.max_displacement_mm)),
             pareto_front: r.pareto,
             allowed_mpa: f.map(|f| f.criterion.allowed_mpa),
             safety_factor: f.map(|f| f.criterion.safety_factor),
@@ -444,8 +439,8 @@ pub fn cells(r: &RankRow) -> [String; 15] {
             format!("{} ({})", r.status.word(), notes.join("; "))
         },
         f.map_or_else(dash, |f| format!("{:.2}", f.criterion.safety_factor)),
-        stress(f.map(|f| &f.fem.fx)),
-        stress(f.map(|f| &f.fem.fy)),
+        stress(f.and_then(|f| f.fem.cases.get("fx"))),
+        stress(f.and_then(|f| f.fem.cases.get("fy"))),
         r.cycle.map_or_else(dash, |c| {
             format!(
                 "{:.1} at φ = {:.0}°",
@@ -460,13 +455,7 @@ pub fn cells(r: &RankRow) -> [String; 15] {
         format!("{:.5}", r.mass.i_zz_kgm2),
         format!("{:.6}", r.mass.i_xx_kgm2),
         f.map_or_else(dash, |f| {
-            format!(
-                "{:.4}",
-                f.fem
-                    .fx
-                    .max_displacement_mm
-                    .max(f.fem.fy.max_displacement_mm)
-            )
+            format!("{:.4}", f.fem.cases.max_of(|c| c.max_displacement_mm))
         }),
         if r.pareto {
             "yes".into()
@@ -547,7 +536,7 @@ pub fn validity_notes(results: &StudyResults) -> Vec<(String, String)> {
 /// What the error bar of a case's judged peak is made of, in words: the discretisation part, the
 /// geometry part (an STL's facets) and which dominates.
 pub fn error_split(case: &crate::rod::LoadCaseResult) -> String {
-    let label = if case.name == "fx" { "F_x" } else { "F_y" };
+    let label = crate::rod::cases::label(&case.name);
     let d = case.estimated_discretisation_error_rel;
     let head = format!(
         "{label} {:.1} MPa ± {:.1} %",
@@ -572,15 +561,29 @@ pub fn error_split(case: &crate::rod::LoadCaseResult) -> String {
     }
 }
 
+/// The error bars of all judged peaks of `fem` ([`error_split`]), from the last case to the first
+/// (F_y before F_x).
+pub fn error_splits(fem: &crate::rod::FemResult) -> String {
+    fem.cases
+        .iter()
+        .rev()
+        .map(error_split)
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
 /// Per design, the error bars of its judged peaks split into discretisation and geometry.
 pub fn error_notes(results: &StudyResults) -> Vec<(String, String)> {
     ranking(results)
         .into_iter()
         .filter_map(|r| r.fem.map(|f| (r.mass.design.clone(), f)))
         .map(|(d, f)| {
-            let cases = [&f.fem.fy, &f.fem.fx].map(error_split).join("; ");
-            let stl = f.fem.fy.smooth_surface_peak_mpa.is_some()
-                || f.fem.fx.smooth_surface_peak_mpa.is_some();
+            let cases = error_splits(&f.fem);
+            let stl = f
+                .fem
+                .cases
+                .iter()
+                .any(|c| c.smooth_surface_peak_mpa.is_some());
             (
                 d,
                 if stl {

@@ -1,7 +1,8 @@
 //! The rod problem of stage 3 (SPEC "Stage 3 — FEM", thesis §5.3) on the tet10 kernel of
-//! [`crate::fem`]: the pin bores found on the mesh ([`bores`]), the pin loads of the load cases
-//! ([`solve`]), the judged region away from the fixed bore and sharp edges, the half model of a
-//! mirror-symmetric rod, the geometry check on a smooth surface through an STL's vertices
+//! [`crate::fem`]: the pin bores found on the mesh ([`bores`]), the load cases as data ([`cases`])
+//! and how a pin's force enters its bore ([`pin_load`]), their solve ([`solve`]) and records
+//! ([`records`]), the judged region away from the fixed bore and sharp edges ([`judged`]), the half
+//! model of a mirror-symmetric rod ([`half_model`]), the geometry check on a smooth surface through an STL's vertices
 //! ([`smooth`]), what the facets say ([`facets`], [`small_fillets`], [`segment_grid`]), the adaptive
 //! loop ([`adapt`]) and the refinement study ([`refinement`]), the rod's buckling ([`buckling`]),
 //! stress over the engine cycle ([`cycle`]) and its fatigue ([`fatigue`]).
@@ -12,10 +13,14 @@
 pub mod adapt;
 pub mod bores;
 pub mod buckling;
+pub mod cases;
 pub mod cycle;
 pub mod facets;
 pub mod fatigue;
+pub mod half_model;
+pub mod judged;
 pub mod pin_load;
+pub mod records;
 pub mod refinement;
 pub mod segment_grid;
 pub mod small_fillets;
@@ -23,4 +28,5 @@ pub mod smooth;
 pub mod solve;
 
 pub use bores::{BoreRole, BoreSpec, BoreSurface};
-pub use solve::{FemResult, LoadCaseResult, RodOptions, solve_rod};
+pub use records::{FemResult, LoadCaseResult, LoadCases};
+pub use solve::{RodOptions, RodSolution, solve_rod};

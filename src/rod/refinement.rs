@@ -7,7 +7,8 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use super::bores::BoreSpec;
-use super::solve::{LoadCaseResult, RodOptions, solve_rod};
+use super::records::LoadCaseResult;
+use super::solve::{RodOptions, solve_rod};
 use crate::fem::error::{FemError, Result};
 use crate::fem::material::Material;
 use crate::fem::mesh::TetMesh;
@@ -16,6 +17,8 @@ use crate::fem::statics::Timings;
 /// The stress measures of one case at one size.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct CaseMeasures {
+    /// The case ([`super::cases`]).
+    pub name: String,
     /// Max element-nodal von Mises, MPa.
     pub max_unaveraged_mpa: f64,
     /// Max nodally averaged von Mises, MPa.
@@ -34,6 +37,7 @@ pub struct CaseMeasures {
 impl From<&LoadCaseResult> for CaseMeasures {
     fn from(c: &LoadCaseResult) -> Self {
         CaseMeasures {
+            name: c.name.clone(),
             max_unaveraged_mpa: c.max_von_mises_unaveraged_mpa,
             max_averaged_mpa: c.max_von_mises_averaged_mpa,
             max_away_from_fixed_mpa: c.max_von_mises_away_from_fixed_mpa,
@@ -59,16 +63,21 @@ pub struct RefinementLevel {
     pub dofs: usize,
     /// Stored entries of the Cholesky factor.
     pub nnz_l: usize,
-    /// Case F_x.
-    pub fx: CaseMeasures,
-    /// Case F_y.
-    pub fy: CaseMeasures,
+    /// The load cases, in the order of [`super::cases::STATIC_CASES`].
+    pub cases: Vec<CaseMeasures>,
     /// Meshing time, s (0 when the mesh was given).
     pub mesh_s: f64,
     /// Analysis times.
     pub timings: Timings,
     /// Analysis wall time, s.
     pub solve_total_s: f64,
+}
+
+impl RefinementLevel {
+    /// The case named `name`.
+    pub fn case(&self, name: &str) -> Option<&CaseMeasures> {
+        self.cases.iter().find(|c| c.name == name)
+    }
 }
 
 /// A refinement study.
@@ -116,8 +125,7 @@ pub fn refinement_study(
             elements: r.elements,
             dofs: r.dofs,
             nnz_l: r.nnz_l,
-            fx: (&r.fx).into(),
-            fy: (&r.fy).into(),
+            cases: r.cases.iter().map(CaseMeasures::from).collect(),
             mesh_s,
             timings: r.timings,
             solve_total_s: t.elapsed().as_secs_f64(),

@@ -494,10 +494,10 @@ pub fn curve_onto_half(
 }
 
 /// The judged peaks of a mesh curved onto the smooth surface ([`geometry_check`]).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct GeometryCheck {
-    /// Per case (F_x, F_y): the judged peak of the curved mesh, MPa.
-    pub peaks_mpa: [f64; 2],
+    /// Per case ([`super::cases::STATIC_CASES`]): the judged peak of the curved mesh, MPa.
+    pub peaks_mpa: Vec<f64>,
     pub stats: CurveStats,
     /// Wall time (curving, solving), s.
     pub seconds: f64,
@@ -520,14 +520,16 @@ pub fn geometry_check(
     let start = std::time::Instant::now();
     let plane = rod
         .mirror_plane_z_m
-        .map(|c| (c, super::solve::mirror_plane_tolerance(mesh)));
+        .map(|c| (c, super::half_model::mirror_plane_tolerance(mesh)));
     let (curved, stats) = curve_onto_half(mesh, surface, 1e3, plane)?;
-    let (_, sol) = super::solve::solve_rod_on(curved, material, bores, force_n, rod)?;
+    let (_, sol) = super::half_model::solve_rod_on(curved, material, bores, force_n, rod)?;
     Ok(GeometryCheck {
-        peaks_mpa: [
-            sol.result.fx.max_von_mises_away_from_fixed_mpa,
-            sol.result.fy.max_von_mises_away_from_fixed_mpa,
-        ],
+        peaks_mpa: sol
+            .result
+            .cases
+            .iter()
+            .map(|c| c.max_von_mises_away_from_fixed_mpa)
+            .collect(),
         stats,
         seconds: start.elapsed().as_secs_f64(),
     })
@@ -535,8 +537,8 @@ pub fn geometry_check(
 
 impl GeometryCheck {
     /// Its record (the surface in millimetres).
-    pub fn record(&self) -> super::solve::GeometryCheckRecord {
-        super::solve::GeometryCheckRecord {
+    pub fn record(&self) -> super::records::GeometryCheckRecord {
+        super::records::GeometryCheckRecord {
             moved_nodes: self.stats.moved_nodes,
             damped_nodes: self.stats.damped_nodes,
             unmatched_nodes: self.stats.unmatched_nodes,

@@ -46,17 +46,14 @@ pub fn verdict(fem: &FemResult, config: &StudyConfig, centre_distance_mm: f64) -
                 1.0
             }
     };
-    let (fx, fy) = (judged(&fem.fx), judged(&fem.fy));
-    let (governing, case, err) = if fy >= fx {
-        (fy, "fy", fem.fy.estimated_error_rel)
-    } else {
-        (fx, "fx", fem.fx.estimated_error_rel)
-    };
-    let peak = fem
-        .fx
-        .max_von_mises_away_from_fixed_mpa
-        .max(fem.fy.max_von_mises_away_from_fixed_mpa);
-    let displacement = fem.fx.max_displacement_mm.max(fem.fy.max_displacement_mm);
+    let governing_case = fem.cases.governing_by(judged);
+    let (governing, case, err) = (
+        judged(governing_case),
+        governing_case.name.as_str(),
+        governing_case.estimated_error_rel,
+    );
+    let peak = fem.cases.max_of(|c| c.max_von_mises_away_from_fixed_mpa);
+    let displacement = fem.cases.max_of(|c| c.max_displacement_mm);
     let mut model_validity = Vec::new();
     if peak > config.criterion.yield_mpa {
         model_validity.push(format!(
@@ -78,10 +75,7 @@ pub fn verdict(fem: &FemResult, config: &StudyConfig, centre_distance_mm: f64) -
         governing_case: case.into(),
         governing_error_rel: err,
         with_error,
-        raw_peak_mpa: fem
-            .fx
-            .max_von_mises_unaveraged_mpa
-            .max(fem.fy.max_von_mises_unaveraged_mpa),
+        raw_peak_mpa: fem.cases.max_of(|c| c.max_von_mises_unaveraged_mpa),
         safety_factor: config.criterion.yield_mpa / governing,
         pass: governing <= allowed,
         static_pass: governing <= allowed,

@@ -120,7 +120,7 @@ pub struct AdaptiveSummary {
     /// Median facet spacing of the STL's curved surfaces, mm (the typical floor).
     pub facet_spacing_median_mm: f64,
     /// Whether each case's peak sequence changed monotonically (Richardson applies), fx and fy.
-    pub monotone: [bool; 2],
+    pub monotone: Vec<bool>,
 }
 
 /// The stress criterion applied to one design.

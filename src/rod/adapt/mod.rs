@@ -48,10 +48,11 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use super::bores::BoreSpec;
-use super::solve::{
-    AdaptiveStep, DEFAULT_FIXED_BAND_M, MeshPhases, RodOptions, RodSolution, StepTimings,
-    solve_rod_on,
-};
+use super::cases::STATIC_CASES;
+use super::half_model::solve_rod_on;
+use super::judged::DEFAULT_FIXED_BAND_M;
+use super::records::{AdaptiveStep, LoadCaseResult, MeshPhases, StepTimings};
+use super::solve::{RodOptions, RodSolution};
 use crate::fem::error::{FemError, Result};
 use crate::fem::material::Material;
 use crate::fem::mesh::{TetMesh, dist};
@@ -150,7 +151,7 @@ pub struct AdaptiveSolution {
     /// Why it stopped.
     pub stop: StopReason,
     /// Per iteration: whether the peak sequence converged monotonically so far, per case.
-    pub monotone: [bool; 2],
+    pub monotone: Vec<bool>,
     /// Seconds spent meshing, in all.
     pub mesh_s: f64,
     /// Wall time of the whole loop, s.
@@ -327,11 +328,14 @@ pub fn adaptive_rod(
         ..rod.clone()
     };
     let tau = opts.target_error_rel;
-    let mut histories = [PeakHistory::default(), PeakHistory::default()];
-    for h in &mut histories {
-        h.monotone = true;
-    }
-    let mut steps: [Vec<AdaptiveStep>; 2] = [Vec::new(), Vec::new()];
+    let n_cases = STATIC_CASES.len();
+    let mut histories: Vec<PeakHistory> = (0..n_cases)
+        .map(|_| PeakHistory {
+            monotone: true,
+            ..PeakHistory::default()
+        })
+        .collect();
+    let mut steps: Vec<Vec<AdaptiveStep>> = vec![Vec::new(); n_cases];
     let mut mesh_s = 0.0;
     let mut next_sizes: Option<(TetMesh, Vec<f64>)> = None;
     let mut iteration = 0;
@@ -359,9 +363,9 @@ pub fn adaptive_rod(
         let (mesh, sol) = solve_rod_on(mesh, material, bores, force_n, &rod_opts)?;
         let sizes = element_sizes(&mesh);
         let elems_of = node_elements(&mesh);
-        let cases = [&sol.result.fx, &sol.result.fy];
-        let mut estimates = [0.0; 2];
-        for c in 0..2 {
+        let cases: &[LoadCaseResult] = &sol.result.cases;
+        let mut estimates = vec![0.0; n_cases];
+        for c in 0..n_cases {
             let est = &sol.estimates[c];
             let peak_pa = cases[c].max_von_mises_away_from_fixed_mpa * 1e6;
             let loc = cases[c]
@@ -402,12 +406,15 @@ pub fn adaptive_rod(
         }
         // the target is relative to the governing peak (the one the criterion judges): the
         // smaller case's error only has to be that small in MPa, τ·P_gov
-        let peaks = [
-            sol.result.fx.max_von_mises_away_from_fixed_mpa,
-            sol.result.fy.max_von_mises_away_from_fixed_mpa,
-        ];
-        let governing = peaks[0].max(peaks[1]);
-        let targets: [f64; 2] = std::array::from_fn(|c| tau * (governing / peaks[c]).max(1.0));
+        let peaks: Vec<f64> = cases
+            .iter()
+            .map(|c| c.max_von_mises_away_from_fixed_mpa)
+            .collect();
+        let governing = peaks.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let targets: Vec<f64> = peaks
+            .iter()
+            .map(|p| tau * (governing / p).max(1.0))
+            .collect();
         // a sequence whose last mesh is coarser at the governing peak than the one before has
         // not shown that it converged there (the smaller case's peak, judged in MPa of the
         // governing one, may coarsen)
@@ -416,7 +423,7 @@ pub fn adaptive_rod(
             peaks[c] >= governing && v.len() >= 2 && v[v.len() - 1].1 > 1.05 * v[v.len() - 2].1
         };
         let converged =
-            iteration >= 1 && (0..2).all(|c| estimates[c] <= targets[c] && !coarsened(c));
+            iteration >= 1 && (0..n_cases).all(|c| estimates[c] <= targets[c] && !coarsened(c));
         let stop = if converged {
             Some(StopReason::Converged)
         } else if last {
@@ -442,7 +449,7 @@ pub fn adaptive_rod(
         let mut new_sizes = new_sizes;
         if let Some(ns) = &mut new_sizes {
             let mut stuck = true;
-            for c in 0..2 {
+            for c in 0..n_cases {
                 let (_, h_now, loc) = *histories[c].values.last().expect("pushed");
                 let node = nearest_node(&mesh, loc);
                 let floor = floor_at(&mesh, &sol, opts, geometry, node);
@@ -480,10 +487,7 @@ pub fn adaptive_rod(
         }
         if let Some(stop) = stop {
             let mut solution = sol;
-            for (c, case) in [&mut solution.result.fx, &mut solution.result.fy]
-                .into_iter()
-                .enumerate()
-            {
+            for (c, case) in solution.result.cases.iter_mut().enumerate() {
                 case.set_error_bar(estimates[c], case.estimated_geometry_error_rel);
                 case.adaptive = steps[c].clone();
             }
@@ -492,7 +496,7 @@ pub fn adaptive_rod(
                 mesh,
                 solution,
                 stop,
-                monotone: [histories[0].monotone, histories[1].monotone],
+                monotone: histories.iter().map(|h| h.monotone).collect(),
                 mesh_s,
                 total_s: t_all.elapsed().as_secs_f64(),
             });
@@ -577,18 +581,18 @@ fn refine_sizes(
     sol: &RodSolution,
     sizes: &[f64],
     elems_of: &[Vec<u32>],
-    estimates: &[f64; 2],
-    targets: &[f64; 2],
+    estimates: &[f64],
+    targets: &[f64],
     opts: &AdaptOptions,
     geometry: &GeometrySizes<'_>,
 ) -> Vec<f64> {
     use rayon::prelude::*;
     let q = opts.order;
     let away = &sol.away_from_fixed;
-    let cases = [&sol.result.fx, &sol.result.fy];
+    let cases: &[LoadCaseResult] = &sol.result.cases;
     // per element: the smallest size any case asks for
     let mut want: Vec<f64> = sizes.iter().map(|h| h * 2.0).collect();
-    for c in 0..2 {
+    for c in 0..cases.len() {
         let est = &sol.estimates[c];
         let peak = cases[c].max_von_mises_away_from_fixed_mpa * 1e6;
         let loc = cases[c]

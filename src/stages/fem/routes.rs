@@ -10,9 +10,10 @@ use crate::mesher::{MeshReport, read_volume_mesh};
 use crate::rod::RodOptions;
 use crate::rod::adapt::{AdaptOptions, GeometrySizes, adaptive_rod};
 use crate::rod::facets::FacetScale;
+use crate::rod::half_model::solve_rod_on;
 use crate::rod::refinement::{RefinementStudy, refinement_study};
 use crate::rod::small_fillets::{SMALL_FILLET_RADIUS_MM, SMALL_FILLET_REACH_MM, SmallFillets};
-use crate::rod::solve::{rod_fields, solve_rod_on, solve_rod_static};
+use crate::rod::solve::{rod_fields, solve_rod_static};
 use anyhow::{Context, Result};
 use std::path::Path;
 
@@ -138,7 +139,12 @@ pub fn fem_adaptive(
     let mut out = out;
     let buckling_run = setup.add_geometry_error(&out.mesh, &mut out.solution, force_n, buckling_n);
     let r = mesher.last_report.expect("at least one mesh");
-    let iterations = out.solution.result.fx.adaptive.len();
+    let iterations = out
+        .solution
+        .result
+        .cases
+        .first()
+        .map_or(0, |c| c.adaptive.len());
     let summary = MeshSummary {
         source: format!("{}, adaptive", setup.source()),
         size_mm: None,

@@ -10,8 +10,9 @@ use crate::fem::{Material, TetMesh};
 use crate::mesher::{GmshRodMesher, MESHER_SCRIPT, StepInRodFrame};
 use crate::python_env::{pipeline_script, python};
 use crate::rod::facets::{MAX_FILLET_RADIUS_MM, SurfaceEdges};
+use crate::rod::records::HalfModel;
 use crate::rod::smooth::{SmoothSurface, geometry_check};
-use crate::rod::solve::{HalfModel, RodSolution};
+use crate::rod::solve::RodSolution;
 use crate::rod::{BoreSpec, RodOptions};
 use anyhow::{Context, Result};
 use std::path::Path;
@@ -255,13 +256,14 @@ impl Setup {
             })
         };
         let r = &mut solution.result;
-        let peaks = [
-            r.fx.max_von_mises_away_from_fixed_mpa,
-            r.fy.max_von_mises_away_from_fixed_mpa,
-        ];
+        let peaks: Vec<f64> = r
+            .cases
+            .iter()
+            .map(|c| c.max_von_mises_away_from_fixed_mpa)
+            .collect();
         // per case: the geometry part (None: could not be estimated) and the smooth peak
-        let (smooth, buckled): ([(Option<f64>, Option<f64>); 2], _) = if self.step.is_some() {
-            ([(Some(0.0), None); 2], buckle())
+        let (smooth, buckled): (Vec<(Option<f64>, Option<f64>)>, _) = if self.step.is_some() {
+            (vec![(Some(0.0), None); peaks.len()], buckle())
         } else {
             let surface = SmoothSurface::new(
                 &self.surface.vertices,
@@ -289,21 +291,23 @@ impl Setup {
             let smooth = match checked {
                 Ok(check) => {
                     r.geometry_check = Some(check.record());
-                    std::array::from_fn(|c| {
-                        let p = check.peaks_mpa[c];
-                        (Some((p - peaks[c]).abs() / peaks[c]), Some(p))
-                    })
+                    check
+                        .peaks_mpa
+                        .iter()
+                        .zip(&peaks)
+                        .map(|(p, peak)| (Some((p - peak).abs() / peak), Some(*p)))
+                        .collect()
                 }
                 Err(e) => {
                     r.warnings.push(format!(
                         "the geometry error (what the STL's facets do to the judged peak) is unknown: the mesh curved onto the smooth surface through the STL's vertices could not be solved ({e}); the error bars are the discretisation's alone"
                     ));
-                    [(None, None); 2]
+                    vec![(None, None); peaks.len()]
                 }
             };
             (smooth, buckled)
         };
-        for (case, (g, p)) in [&mut r.fx, &mut r.fy].into_iter().zip(smooth) {
+        for (case, (g, p)) in r.cases.iter_mut().zip(smooth) {
             case.set_error_bar(case.estimated_discretisation_error_rel, g);
             case.smooth_surface_peak_mpa = p;
         }
