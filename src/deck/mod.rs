@@ -17,17 +17,22 @@
 //! its "C3D10" section. Deck units are kept as given (no conversion).
 
 pub mod cards;
+pub mod constraint_cards;
+pub mod fields;
+pub mod load_cards;
 pub mod mesh_cards;
 pub mod model;
 pub mod output;
+pub mod output_cards;
 pub mod parse;
 pub mod solve;
+pub mod system;
 
 use std::path::Path;
 
 use crate::fem::error::{FemError, Result};
 pub use model::Model;
-pub use solve::{DeckSolution, SolveOptions, solve_model};
+pub use solve::{DeckSolution, SolveOptions, solve_model, solve_model_at};
 
 /// Reads and checks the deck at `path`. A deck is ASCII in its cards; bytes that are not UTF-8
 /// (a Latin-1 `é` in a `**` comment, as older pre-processors write) are read as U+FFFD, so that
