@@ -43,10 +43,12 @@ pub fn run(args: SolveArgs) -> Result<i32> {
         ExtrapolationArg::Calculix => Extrapolation::CalculiX,
     };
     // the solve's refusals (a mechanism, an inverted element) name the deck, as its read's do
-    let sol = deck::solve_model_at(&args.deck, &model, SolveOptions { extrapolation })
-        .map_err(|e| match e {
-            crate::fem::FemError::Parse { .. } => anyhow::anyhow!("{e}"),
-            e => anyhow::anyhow!("{}: {e}", args.deck.display()),
+    let sol =
+        deck::solve_model_at(&args.deck, &model, SolveOptions { extrapolation }).map_err(|e| {
+            match e {
+                crate::fem::FemError::Parse { .. } => anyhow::anyhow!("{e}"),
+                e => anyhow::anyhow!("{}: {e}", args.deck.display()),
+            }
         })?;
     for w in &sol.warnings {
         eprintln!("warning: {w}");
@@ -94,7 +96,11 @@ pub fn run(args: SolveArgs) -> Result<i32> {
                 outln!("  buckling factor {}: {b:.7e}", k + 1);
             }
             for (k, f) in eig.frequencies.iter().enumerate() {
-                outln!("  frequency {}: {f:.7e} cycles/time (eigenvalue {:.7e})", k + 1, eig.eigenvalues[k]);
+                outln!(
+                    "  frequency {}: {f:.7e} cycles/time (eigenvalue {:.7e})",
+                    k + 1,
+                    eig.eigenvalues[k]
+                );
             }
         }
         for (name, r) in &st.reaction_totals {

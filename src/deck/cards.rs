@@ -49,8 +49,14 @@ fn allowed_params(keyword: &str) -> Option<&'static [&'static str]> {
 /// What ccx does that rodstudy does not, for the message of a refused keyword.
 fn why_refused(keyword: &str) -> &'static str {
     match keyword {
-        "CONTACT PAIR" | "SURFACE INTERACTION" | "SURFACE BEHAVIOR" | "FRICTION" | "TIE"
-        | "CONTACT FILE" | "CONTACT PRINT" | "CONTACT OUTPUT" => "contact is not supported",
+        "CONTACT PAIR"
+        | "SURFACE INTERACTION"
+        | "SURFACE BEHAVIOR"
+        | "FRICTION"
+        | "TIE"
+        | "CONTACT FILE"
+        | "CONTACT PRINT"
+        | "CONTACT OUTPUT" => "contact is not supported",
         "COUPLING" | "KINEMATIC" | "DISTRIBUTING" | "RIGID BODY" => {
             "couplings to a reference node are not supported: load the nodes directly \
              (*CLOAD) or tie them with *EQUATION"
@@ -58,10 +64,16 @@ fn why_refused(keyword: &str) -> &'static str {
         "PLASTIC" | "HYPERELASTIC" | "CREEP" | "DEFORMATION PLASTICITY" | "USER MATERIAL" => {
             "nonlinear materials are not supported (linear elastic only)"
         }
-        "TEMPERATURE" | "INITIAL CONDITIONS" | "HEAT TRANSFER" | "COUPLED TEMPERATURE-DISPLACEMENT"
-        | "CONDUCTIVITY" | "SPECIFIC HEAT" | "FILM" | "RADIATE" | "DFLUX" | "CFLUX" => {
-            "thermal analysis is not supported"
-        }
+        "TEMPERATURE"
+        | "INITIAL CONDITIONS"
+        | "HEAT TRANSFER"
+        | "COUPLED TEMPERATURE-DISPLACEMENT"
+        | "CONDUCTIVITY"
+        | "SPECIFIC HEAT"
+        | "FILM"
+        | "RADIATE"
+        | "DFLUX"
+        | "CFLUX" => "thermal analysis is not supported",
         "DYNAMIC" | "MODAL DYNAMIC" | "STEADY STATE DYNAMICS" | "VISCO" | "AMPLITUDE" => {
             "only *STATIC, *BUCKLE and *FREQUENCY steps are supported"
         }
@@ -462,7 +474,9 @@ fn read_elastic(path: &Path, card: &Card) -> Result<(f64, f64)> {
         return Err(error(
             path,
             d.line,
-            format!("Young's modulus {e} is not positive: no material has E ≤ 0; the line is 'E, ν'"),
+            format!(
+                "Young's modulus {e} is not positive: no material has E ≤ 0; the line is 'E, ν'"
+            ),
         ));
     }
     if !(nu > -1.0 && nu < 0.5) {
@@ -483,10 +497,21 @@ fn read_elastic(path: &Path, card: &Card) -> Result<(f64, f64)> {
 fn read_analysis(path: &Path, card: &Card, warnings: &mut Vec<String>) -> Result<Analysis> {
     if let Some(s) = card.param("SOLVER") {
         // the solver of the linear equations: all give the same solution to round-off
-        let known = ["SPOOLES", "PARDISO", "PASTIX", "SPARSE", "ITERATIVE SCALING",
-            "ITERATIVE CHOLESKY", "DEFAULT"];
+        let known = [
+            "SPOOLES",
+            "PARDISO",
+            "PASTIX",
+            "SPARSE",
+            "ITERATIVE SCALING",
+            "ITERATIVE CHOLESKY",
+            "DEFAULT",
+        ];
         if !known.iter().any(|k| s.eq_ignore_ascii_case(k)) {
-            return Err(error(path, card.line, format!("SOLVER={s}: unknown solver")));
+            return Err(error(
+                path,
+                card.line,
+                format!("SOLVER={s}: unknown solver"),
+            ));
         }
     }
     match card.keyword.as_str() {
@@ -504,18 +529,30 @@ fn read_analysis(path: &Path, card: &Card, warnings: &mut Vec<String>) -> Result
         "BUCKLE" => {
             let d = &card.data[0];
             if d.fields.len() > 4 {
-                return Err(error(path, d.line, "a *BUCKLE line is 'modes[, accuracy, ncv, iterations]'"));
+                return Err(error(
+                    path,
+                    d.line,
+                    "a *BUCKLE line is 'modes[, accuracy, ncv, iterations]'",
+                ));
             }
             let modes = int(path, d.line, &d.fields[0], "number of buckling factors")?;
             if !(1..=100).contains(&modes) {
-                return Err(error(path, d.line, format!("{modes} buckling factors: ask for 1 to 100")));
+                return Err(error(
+                    path,
+                    d.line,
+                    format!("{modes} buckling factors: ask for 1 to 100"),
+                ));
             }
             let accuracy = match d.fields.get(1).filter(|f| !f.is_empty()) {
                 Some(_) => num(path, d, 1, "accuracy")?,
                 None => 0.01,
             };
             if !(accuracy > 0.0 && accuracy < 1.0) {
-                return Err(error(path, d.line, format!("accuracy {accuracy}: 0 < accuracy < 1")));
+                return Err(error(
+                    path,
+                    d.line,
+                    format!("accuracy {accuracy}: 0 < accuracy < 1"),
+                ));
             }
             Ok(Analysis::Buckle {
                 modes: modes as usize,
@@ -523,19 +560,44 @@ fn read_analysis(path: &Path, card: &Card, warnings: &mut Vec<String>) -> Result
             })
         }
         _ => {
-            if card.param("STORAGE").is_some_and(|v| !v.eq_ignore_ascii_case("NO")) {
-                return Err(error(path, card.line, "*FREQUENCY, STORAGE=YES is not supported"));
+            if card
+                .param("STORAGE")
+                .is_some_and(|v| !v.eq_ignore_ascii_case("NO"))
+            {
+                return Err(error(
+                    path,
+                    card.line,
+                    "*FREQUENCY, STORAGE=YES is not supported",
+                ));
             }
-            if card.param("CYCMPC").is_some_and(|v| !v.eq_ignore_ascii_case("INACTIVE")) {
-                return Err(error(path, card.line, "*FREQUENCY, CYCMPC: cyclic symmetry is not supported"));
+            if card
+                .param("CYCMPC")
+                .is_some_and(|v| !v.eq_ignore_ascii_case("INACTIVE"))
+            {
+                return Err(error(
+                    path,
+                    card.line,
+                    "*FREQUENCY, CYCMPC: cyclic symmetry is not supported",
+                ));
             }
-            let d = card.data.first().ok_or_else(|| error(path, card.line, "*FREQUENCY without its data line"))?;
+            let d = card
+                .data
+                .first()
+                .ok_or_else(|| error(path, card.line, "*FREQUENCY without its data line"))?;
             if d.fields.len() > 3 {
-                return Err(error(path, d.line, "a *FREQUENCY line is 'modes[, lower, upper]' (cycles/time)"));
+                return Err(error(
+                    path,
+                    d.line,
+                    "a *FREQUENCY line is 'modes[, lower, upper]' (cycles/time)",
+                ));
             }
             let modes = int(path, d.line, &d.fields[0], "number of frequencies")?;
             if !(1..=100).contains(&modes) {
-                return Err(error(path, d.line, format!("{modes} frequencies: ask for 1 to 100")));
+                return Err(error(
+                    path,
+                    d.line,
+                    format!("{modes} frequencies: ask for 1 to 100"),
+                ));
             }
             let lower = match d.fields.get(1).filter(|f| !f.is_empty()) {
                 Some(_) => num(path, d, 1, "lower frequency")?,

@@ -24,7 +24,11 @@ impl Model {
                 let mut faces = Vec::new();
                 for d in &card.data {
                     let elements = self.element_target(path, d)?;
-                    let label = d.fields.get(1).map(|s| s.to_ascii_uppercase()).unwrap_or_default();
+                    let label = d
+                        .fields
+                        .get(1)
+                        .map(|s| s.to_ascii_uppercase())
+                        .unwrap_or_default();
                     let face = match label.as_str() {
                         "S1" | "S2" | "S3" | "S4" => (label.as_bytes()[1] - b'1') as usize,
                         _ => {
@@ -39,7 +43,11 @@ impl Model {
                         }
                     };
                     if d.fields.len() > 2 {
-                        return Err(error(path, d.line, "an element-face line is 'element|elset, Sk'"));
+                        return Err(error(
+                            path,
+                            d.line,
+                            "an element-face line is 'element|elset, Sk'",
+                        ));
                     }
                     faces.extend(elements.into_iter().map(|e| (e, face)));
                 }
@@ -65,7 +73,11 @@ impl Model {
                 push_unique(self.nsets.entry(name).or_default(), nodes);
             }
             _ => {
-                return Err(error(path, card.line, format!("*SURFACE, TYPE={ty}: ELEMENT or NODE")));
+                return Err(error(
+                    path,
+                    card.line,
+                    format!("*SURFACE, TYPE={ty}: ELEMENT or NODE"),
+                ));
             }
         }
         Ok(())
@@ -95,7 +107,11 @@ impl Model {
             .ok_or_else(|| error(path, card.line, format!("node set {set} is not defined")))?;
         let d = &card.data[0];
         if d.fields.len() != 6 {
-            return Err(error(path, d.line, "a *TRANSFORM line is 'a1, a2, a3, b1, b2, b3'"));
+            return Err(error(
+                path,
+                d.line,
+                "a *TRANSFORM line is 'a1, a2, a3, b1, b2, b3'",
+            ));
         }
         let v: Vec<f64> = (0..6)
             .map(|k| num(path, d, k, "coordinate"))
@@ -110,18 +126,35 @@ impl Model {
                     a[2] * b[0] - a[0] * b[2],
                     a[0] * b[1] - a[1] * b[0],
                 ];
-                if cross.iter().all(|c| c.abs() < 1e-12 * (norm(a) * norm(b)).max(f64::MIN_POSITIVE)) {
-                    return Err(error(path, d.line, "TYPE=R: a and b must be non-zero and not parallel"));
+                if cross
+                    .iter()
+                    .all(|c| c.abs() < 1e-12 * (norm(a) * norm(b)).max(f64::MIN_POSITIVE))
+                {
+                    return Err(error(
+                        path,
+                        d.line,
+                        "TYPE=R: a and b must be non-zero and not parallel",
+                    ));
                 }
                 Transform::Rectangular { a, b }
             }
             "C" => {
                 if norm([b[0] - a[0], b[1] - a[1], b[2] - a[2]]) == 0.0 {
-                    return Err(error(path, d.line, "TYPE=C: the axis points a and b coincide"));
+                    return Err(error(
+                        path,
+                        d.line,
+                        "TYPE=C: the axis points a and b coincide",
+                    ));
                 }
                 Transform::Cylindrical { a, b }
             }
-            _ => return Err(error(path, card.line, format!("*TRANSFORM, TYPE={ty}: R or C"))),
+            _ => {
+                return Err(error(
+                    path,
+                    card.line,
+                    format!("*TRANSFORM, TYPE={ty}: R or C"),
+                ));
+            }
         };
         for n in nodes {
             self.transforms.insert(n, t);
@@ -141,7 +174,11 @@ impl Model {
             }
             let count = int(path, head.line, &head.fields[0], "number of terms")?;
             if count < 1 {
-                return Err(error(path, head.line, "an equation needs at least one term"));
+                return Err(error(
+                    path,
+                    head.line,
+                    "an equation needs at least one term",
+                ));
             }
             let mut terms = Vec::new();
             while terms.len() < count as usize {
@@ -153,7 +190,11 @@ impl Model {
                     )
                 })?;
                 if d.fields.len() % 3 != 0 {
-                    return Err(error(path, d.line, "equation terms are 'node, dof, coefficient' triples"));
+                    return Err(error(
+                        path,
+                        d.line,
+                        "equation terms are 'node, dof, coefficient' triples",
+                    ));
                 }
                 for k in (0..d.fields.len()).step_by(3) {
                     let id = int(path, d.line, &d.fields[k], "node")?;
@@ -171,10 +212,18 @@ impl Model {
                 }
             }
             if terms.len() != count as usize {
-                return Err(error(path, head.line, format!("an equation of {count} terms has {}", terms.len())));
+                return Err(error(
+                    path,
+                    head.line,
+                    format!("an equation of {count} terms has {}", terms.len()),
+                ));
             }
             if terms[0].2 == 0.0 {
-                return Err(error(path, head.line, "the first coefficient of an equation (its dependent DOF's) is zero"));
+                return Err(error(
+                    path,
+                    head.line,
+                    "the first coefficient of an equation (its dependent DOF's) is zero",
+                ));
             }
             self.equations.push((terms, head.line));
         }

@@ -105,7 +105,11 @@ impl Model {
             }
             let v = load(path, d, 2, "load")?;
             if d.fields.len() > 3 {
-                return Err(error(path, d.line, "a *CLOAD line is 'node|nset, dof, value'"));
+                return Err(error(
+                    path,
+                    d.line,
+                    "a *CLOAD line is 'node|nset, dof, value'",
+                ));
             }
             for &n in &nodes {
                 let key = (n, (dof - 1) as usize);
@@ -158,7 +162,13 @@ impl Model {
                 "GRAV" => {
                     let elements = self.element_target(path, d)?;
                     let g = load(path, d, 2, "gravity magnitude")?;
-                    let dir = direction(path, d, 3, "a GRAV line is 'elset, GRAV, g, nx, ny, nz' with a non-zero direction", 6)?;
+                    let dir = direction(
+                        path,
+                        d,
+                        3,
+                        "a GRAV line is 'elset, GRAV, g, nx, ny, nz' with a non-zero direction",
+                        6,
+                    )?;
                     let this = Grav { g, dir };
                     for &e in &elements {
                         let grav = if r.gravity_here.insert(e) {
@@ -188,7 +198,11 @@ impl Model {
                          non-zero axis",
                         9,
                     )?;
-                    let this = Centrif { omega2, point, axis };
+                    let this = Centrif {
+                        omega2,
+                        point,
+                        axis,
+                    };
                     for &e in &elements {
                         if r.centrif_here.insert(e) {
                             r.state.centrif.insert(e, this);
@@ -230,7 +244,11 @@ impl Model {
     ) -> Result<()> {
         let p = load(path, d, 2, "pressure")?;
         if d.fields.len() > 3 {
-            return Err(error(path, d.line, "a pressure line is 'element|elset|surface, Pk|P, p'"));
+            return Err(error(
+                path,
+                d.line,
+                "a pressure line is 'element|elset|surface, Pk|P, p'",
+            ));
         }
         for &key in faces {
             if r.pressures_here.insert(key) {

@@ -84,20 +84,47 @@ pub fn write_step_vtu(path: &Path, sol: &DeckSolution, k: usize) -> Result<()> {
         out,
         "<UnstructuredGrid>\n<Piece NumberOfPoints=\"{np}\" NumberOfCells=\"{nc}\">\n<PointData>"
     );
-    array(&mut out, "node_id", "Int64", 1, used.iter().map(|&n| sol.node_ids[n].to_string()));
+    array(
+        &mut out,
+        "node_id",
+        "Int64",
+        1,
+        used.iter().map(|&n| sol.node_ids[n].to_string()),
+    );
     let wants = |v: &str| step.file_vars.is_empty() || step.file_vars.iter().any(|x| x == v);
     let xyz = ["x", "y", "z"];
     if wants("U") {
-        named_array(&mut out, "U", "Float64", &xyz, 3, used.iter().flat_map(|&n| step.u[n]).map(g));
+        named_array(
+            &mut out,
+            "U",
+            "Float64",
+            &xyz,
+            3,
+            used.iter().flat_map(|&n| step.u[n]).map(g),
+        );
     }
     if wants("RF") {
-        named_array(&mut out, "RF", "Float64", &xyz, 3, used.iter().flat_map(|&n| step.rf[n]).map(g));
+        named_array(
+            &mut out,
+            "RF",
+            "Float64",
+            &xyz,
+            3,
+            used.iter().flat_map(|&n| step.rf[n]).map(g),
+        );
     }
     // CalculiX order [xx, yy, zz, xy, xz, yz] -> ParaView's [xx, yy, zz, xy, yz, xz]
     let pv = |t: &[f64; 6]| [t[0], t[1], t[2], t[3], t[5], t[4]];
     let tensor = ["xx", "yy", "zz", "xy", "yz", "xz"];
     if wants("S") {
-        named_array(&mut out, "S", "Float64", &tensor, 6, used.iter().flat_map(|&n| pv(&step.s[n])).map(g));
+        named_array(
+            &mut out,
+            "S",
+            "Float64",
+            &tensor,
+            6,
+            used.iter().flat_map(|&n| pv(&step.s[n])).map(g),
+        );
         array(
             &mut out,
             "S_von_mises",
@@ -107,7 +134,14 @@ pub fn write_step_vtu(path: &Path, sol: &DeckSolution, k: usize) -> Result<()> {
         );
     }
     if wants("E") {
-        named_array(&mut out, "E", "Float64", &tensor, 6, used.iter().flat_map(|&n| pv(&step.e[n])).map(g));
+        named_array(
+            &mut out,
+            "E",
+            "Float64",
+            &tensor,
+            6,
+            used.iter().flat_map(|&n| pv(&step.e[n])).map(g),
+        );
     }
     for (m, mode) in step.modes.iter().enumerate() {
         named_array(
@@ -120,7 +154,13 @@ pub fn write_step_vtu(path: &Path, sol: &DeckSolution, k: usize) -> Result<()> {
         );
     }
     out.push_str("</PointData>\n<Points>\n");
-    array(&mut out, "Points", "Float64", 3, used.iter().flat_map(|&n| sol.nodes[n]).map(g));
+    array(
+        &mut out,
+        "Points",
+        "Float64",
+        3,
+        used.iter().flat_map(|&n| sol.nodes[n]).map(g),
+    );
     out.push_str("</Points>\n<Cells>\n");
     array(
         &mut out,

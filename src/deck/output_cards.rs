@@ -75,7 +75,11 @@ impl Model {
             Some(t) if t.eq_ignore_ascii_case("YES") => Totals::Yes,
             Some(t) if t.eq_ignore_ascii_case("ONLY") => Totals::Only,
             Some(t) => {
-                return Err(error(path, card.line, format!("TOTALS={t}: NO, YES or ONLY")));
+                return Err(error(
+                    path,
+                    card.line,
+                    format!("TOTALS={t}: NO, YES or ONLY"),
+                ));
             }
         };
         if kw == "EL PRINT" && totals != Totals::No {
@@ -83,6 +87,21 @@ impl Model {
                 path,
                 card.line,
                 "*EL PRINT, TOTALS (sums over elements, e.g. of energies) is not supported",
+            ));
+        }
+        // ccx prints the values of a node with local axes (*TRANSFORM) in them unless
+        // GLOBAL=YES; rodstudy prints global components only, so it asks for GLOBAL=YES there
+        if kw == "NODE PRINT"
+            && card.param("GLOBAL").is_none()
+            && let Some(set) = card.param("NSET")
+            && let Some(nodes) = self.nsets.get(&set.to_ascii_uppercase())
+            && nodes.iter().any(|n| self.transforms.contains_key(n))
+        {
+            return Err(error(
+                path,
+                card.line,
+                "*NODE PRINT of nodes with local axes (*TRANSFORM): ccx prints them in the local \
+                 axes by default, rodstudy in global axes only: add GLOBAL=YES",
             ));
         }
         if let Some(g) = card.param("GLOBAL")
@@ -118,7 +137,11 @@ impl Model {
             "NODE PRINT" => {
                 let set = required(path, card, "NSET")?.to_ascii_uppercase();
                 if !self.nsets.contains_key(&set) {
-                    return Err(error(path, card.line, format!("node set {set} is not defined")));
+                    return Err(error(
+                        path,
+                        card.line,
+                        format!("node set {set} is not defined"),
+                    ));
                 }
                 if !off {
                     r.state.node_print.push((set, vars, totals));

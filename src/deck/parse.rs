@@ -177,7 +177,9 @@ fn include(path: &Path, depth: usize, out: &mut Vec<Card>) -> Result<()> {
         return Err(error(
             path,
             card.line,
-            format!("*INCLUDE nested deeper than {MAX_INCLUDE_DEPTH} files (a file including itself?)"),
+            format!(
+                "*INCLUDE nested deeper than {MAX_INCLUDE_DEPTH} files (a file including itself?)"
+            ),
         ));
     }
     let name = name.trim_matches('"');

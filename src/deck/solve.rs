@@ -189,7 +189,11 @@ pub fn solve_model_at(path: &Path, model: &Model, options: SolveOptions) -> Resu
     Ok(DeckSolution {
         node_ids: model.node_ids.clone(),
         nodes: model.nodes.clone(),
-        elements: model.elements.iter().map(|e| (e.id, e.nodes.clone())).collect(),
+        elements: model
+            .elements
+            .iter()
+            .map(|e| (e.id, e.nodes.clone()))
+            .collect(),
         dofs: 3 * sys.used.iter().filter(|u| **u).count(),
         used: sys.used,
         warnings,
@@ -229,7 +233,12 @@ fn solve_step(
     let mut q = b.clone();
     factor.solve_in_place(&mut q, 1);
     let kq = k.mul(&q);
-    let rnorm = kq.iter().zip(&b).map(|(a, c)| (a - c).powi(2)).sum::<f64>().sqrt();
+    let rnorm = kq
+        .iter()
+        .zip(&b)
+        .map(|(a, c)| (a - c).powi(2))
+        .sum::<f64>()
+        .sqrt();
     let bnorm = b.iter().map(|v| v * v).sum::<f64>().sqrt();
     let residual_rel = if bnorm > 0.0 { rnorm / bnorm } else { rnorm };
     let u = reduction.expand(&q);
@@ -252,7 +261,10 @@ fn solve_step(
     let stress = field(sys, &u, true, options.extrapolation);
     let strain = field(sys, &u, false, options.extrapolation);
     if !stress.nodal.iter().flatten().all(|v| v.is_finite()) {
-        return Err(at("the stresses overflow f64: check the loads and units (*CLOAD, *DLOAD, *ELASTIC)".into()));
+        return Err(at(
+            "the stresses overflow f64: check the loads and units (*CLOAD, *DLOAD, *ELASTIC)"
+                .into(),
+        ));
     }
     // eigen steps
     let mut modes_full: Vec<Vec<f64>> = Vec::new();
@@ -278,7 +290,11 @@ fn solve_step(
                 iterations: pairs.iterations,
             })
         }
-        Analysis::Frequency { modes, lower, upper } => {
+        Analysis::Frequency {
+            modes,
+            lower,
+            upper,
+        } => {
             let mut rho_missing = None;
             let (m, _) = pattern.assemble(&sys.connectivity, &reduction, |e| {
                 let rho = sys.material[e].1.unwrap_or_else(|| {
@@ -294,7 +310,8 @@ fn solve_step(
                 )));
             }
             let start: Vec<f64> = (0..m.n).map(|i| 1.0 + (i % 3) as f64).collect();
-            let pairs = lowest_eigenpairs(&factor, &m, &start, modes, 1e-10, 1000).map_err(|e| at(format!("*FREQUENCY: {e}")))?;
+            let pairs = lowest_eigenpairs(&factor, &m, &start, modes, 1e-10, 1000)
+                .map_err(|e| at(format!("*FREQUENCY: {e}")))?;
             let two_pi = 2.0 * std::f64::consts::PI;
             let mut values = Vec::new();
             for (lam, v) in pairs.values.iter().zip(&pairs.vectors) {
@@ -323,13 +340,24 @@ fn solve_step(
     let nn = model.nodes.len();
     let pick3 = |v: &[f64], n: usize| [v[3 * n], v[3 * n + 1], v[3 * n + 2]];
     let ud: Vec<[f64; 3]> = (0..nn).map(|n| pick3(&u, n)).collect();
-    let rf: Vec<[f64; 3]> = (0..nn).map(|n| if sys.used[n] { pick3(&rf_full, n) } else { [0.0; 3] }).collect();
+    let rf: Vec<[f64; 3]> = (0..nn)
+        .map(|n| {
+            if sys.used[n] {
+                pick3(&rf_full, n)
+            } else {
+                [0.0; 3]
+            }
+        })
+        .collect();
     let s: Vec<[f64; 6]> = stress.nodal.iter().map(ccx_order).collect();
     let e: Vec<[f64; 6]> = strain.nodal.iter().map(ccx_order).collect();
     let modes: Vec<Vec<[f64; 3]>> = modes_full
         .iter()
         .map(|v| {
-            let big = v.iter().copied().fold(0.0f64, |a, x| if x.abs() > a.abs() { x } else { a });
+            let big = v
+                .iter()
+                .copied()
+                .fold(0.0f64, |a, x| if x.abs() > a.abs() { x } else { a });
             let scale = if big != 0.0 { 1.0 / big } else { 1.0 };
             (0..nn).map(|n| pick3(v, n).map(|c| c * scale)).collect()
         })
@@ -366,7 +394,9 @@ fn solve_step(
         let els = &model.elsets[name];
         let has = |v: &str| vars.iter().any(|x| x == v);
         let pick = |f: &super::fields::Field| -> Vec<Vec<[f64; 6]>> {
-            els.iter().map(|&e| f.points[e].iter().map(ccx_order).collect()).collect()
+            els.iter()
+                .map(|&e| f.points[e].iter().map(ccx_order).collect())
+                .collect()
         };
         element_sets.insert(
             name.clone(),

@@ -67,7 +67,11 @@ pub fn deck_system(path: &Path, model: &Model) -> Result<DeckSystem> {
     if !bad.is_empty() {
         return Err(FemError::Parse {
             path: path.to_path_buf(),
-            line: model.elements.iter().find(|e| format!("element {} (line {})", e.id, e.line) == bad[0]).map_or(0, |e| e.line),
+            line: model
+                .elements
+                .iter()
+                .find(|e| format!("element {} (line {})", e.id, e.line) == bad[0])
+                .map_or(0, |e| e.line),
             message: format!(
                 "{} element(s) inverted or degenerate at an integration point (Jacobian \
                  determinant ≤ 0): {}; check the element's node order (corners 1-2-3 \
@@ -177,8 +181,9 @@ pub fn local_axes(t: &Transform, x: [f64; 3]) -> Option<[[f64; 3]; 3]> {
 fn node_axes(path: &Path, model: &Model, n: usize) -> Result<Option<[[f64; 3]; 3]>> {
     match model.transforms.get(&n) {
         None => Ok(None),
-        Some(t) => local_axes(t, model.nodes[n]).map(Some).ok_or_else(|| {
-            FemError::Parse {
+        Some(t) => local_axes(t, model.nodes[n])
+            .map(Some)
+            .ok_or_else(|| FemError::Parse {
                 path: path.to_path_buf(),
                 line: 0,
                 message: format!(
@@ -186,19 +191,35 @@ fn node_axes(path: &Path, model: &Model, n: usize) -> Result<Option<[[f64; 3]; 3
                      tangential directions are undefined",
                     model.node_ids[n]
                 ),
-            }
-        }),
+            }),
     }
 }
 
 /// The constraints of `step`: equations, supports (local where transformed), and the nodes no
 /// element and no equation uses held at zero.
-pub fn step_reduction(path: &Path, model: &Model, sys: &DeckSystem, step: &Step) -> Result<Reduction> {
+pub fn step_reduction(
+    path: &Path,
+    model: &Model,
+    sys: &DeckSystem,
+    step: &Step,
+) -> Result<Reduction> {
     let mut constraints = Vec::new();
     let mut in_equation = HashSet::new();
     for (terms, line) in &model.equations {
+        // a DOF of a node with local axes is the local one (manual, "*EQUATION")
+        let mut global = Vec::new();
+        for &(n, j, c) in terms {
+            match node_axes(path, model, n)? {
+                None => global.push((3 * n + j, c)),
+                Some(axes) => global.extend(
+                    (0..3)
+                        .map(|i| (3 * n + i, c * axes[j][i]))
+                        .filter(|t| t.1 != 0.0),
+                ),
+            }
+        }
         constraints.push(Constraint {
-            terms: terms.iter().map(|&(n, j, c)| (3 * n + j, c)).collect(),
+            terms: global,
             value: 0.0,
             label: format!("{}: *EQUATION of line {line}", path.display()),
         });
@@ -239,7 +260,13 @@ pub fn step_reduction(path: &Path, model: &Model, sys: &DeckSystem, step: &Step)
 }
 
 /// The load vector of `step` (3 per deck node, global axes).
-pub fn step_loads(path: &Path, model: &Model, sys: &DeckSystem, step: &Step, number: usize) -> Result<Vec<f64>> {
+pub fn step_loads(
+    path: &Path,
+    model: &Model,
+    sys: &DeckSystem,
+    step: &Step,
+    number: usize,
+) -> Result<Vec<f64>> {
     let mut f = vec![0.0; 3 * model.nodes.len()];
     for (&(n, j), &v) in &step.cloads {
         if !sys.used[n] {
@@ -304,7 +331,11 @@ pub fn step_loads(path: &Path, model: &Model, sys: &DeckSystem, step: &Step, num
         let el = &model.elements[e];
         for p in &sys.points[e] {
             let x: [f64; 3] = std::array::from_fn(|j| {
-                el.nodes.iter().zip(&p.n).map(|(&n, w)| w * model.nodes[n][j]).sum()
+                el.nodes
+                    .iter()
+                    .zip(&p.n)
+                    .map(|(&n, w)| w * model.nodes[n][j])
+                    .sum()
             });
             let b = force(x);
             for (a, &n) in el.nodes.iter().enumerate() {

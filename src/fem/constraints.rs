@@ -236,8 +236,15 @@ mod tests {
     /// u0 = 1; u1 − u2 = 0; u2 − 2 u3 = 0 (u2 dependent after u1 used it): u1 = u2 = 2 u3.
     #[test]
     fn chains_and_prescribed_values() {
-        let r = Reduction::new(4, &[c(&[(0, 1.0)], 1.0), c(&[(1, 1.0), (2, -1.0)], 0.0), c(&[(2, 1.0), (3, -2.0)], 0.0)])
-            .unwrap();
+        let r = Reduction::new(
+            4,
+            &[
+                c(&[(0, 1.0)], 1.0),
+                c(&[(1, 1.0), (2, -1.0)], 0.0),
+                c(&[(2, 1.0), (3, -2.0)], 0.0),
+            ],
+        )
+        .unwrap();
         assert_eq!(r.n_eq(), 1);
         let u = r.expand(&[0.5]);
         assert_eq!(u, vec![1.0, 1.0, 1.0, 0.5]);

@@ -248,7 +248,11 @@ mod tests {
         let t = DMatrix::from_fn(12, 1, |r, _| if r % 3 == 1 { 1.0 } else { 0.0 });
         assert!((k * t).amax() < 1e-3);
         let m = mass(&p4, 7800.0);
-        let total: f64 = (0..12).step_by(3).flat_map(|r| (0..12).step_by(3).map(move |c| (r, c))).map(|(r, c)| m[(r, c)]).sum();
+        let total: f64 = (0..12)
+            .step_by(3)
+            .flat_map(|r| (0..12).step_by(3).map(move |c| (r, c)))
+            .map(|(r, c)| m[(r, c)])
+            .sum();
         assert!((total - 7800.0 * 0.55).abs() < 1e-9);
     }
 }

@@ -31,9 +31,7 @@ pub struct EigenPairs {
 
 fn mul_block(a: &SparseSym, x: &[f64], q: usize) -> Vec<f64> {
     let n = a.n;
-    (0..q)
-        .flat_map(|k| a.mul(&x[k * n..(k + 1) * n]))
-        .collect()
+    (0..q).flat_map(|k| a.mul(&x[k * n..(k + 1) * n])).collect()
 }
 
 fn gram(a: &[f64], b: &[f64], n: usize, q: usize) -> DMatrix<f64> {
@@ -80,7 +78,11 @@ pub fn lowest_eigenpairs(
     for k in 2..q {
         for i in 0..n {
             // a fixed pseudo-random pattern (no RNG state: reproducible)
-            let h = (i as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (k as u64 * 0xBF58_476D);
+            let mut h = ((k * n + i) as u64).wrapping_add(0x9E37_79B9_7F4A_7C15);
+            // splitmix64's finaliser
+            h = (h ^ (h >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            h = (h ^ (h >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            h ^= h >> 31;
             x[k * n + i] = ((h >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * (1.0 + diag[i]);
         }
     }
@@ -94,17 +96,18 @@ pub fn lowest_eigenpairs(
         let br = gram(&xb, &bx, n, q);
         let kr = 0.5 * (&kr + kr.transpose());
         let br = 0.5 * (&br + br.transpose());
-        let chol = nalgebra::Cholesky::new(kr).ok_or_else(|| {
-            FemError::Solver(
-                "eigenvalues: the projected stiffness is not positive definite (the block \
-                 collapsed: B has fewer independent directions than the block)"
-                    .into(),
-            )
+        let chol = nalgebra::Cholesky::new(kr.clone()).ok_or_else(|| {
+            FemError::Solver(format!(
+                "eigenvalues: the projected stiffness is not positive definite in iteration {it} \
+                 (the block collapsed: B has fewer independent directions than the block; \
+                 diagonal {:?})",
+                kr.diagonal().as_slice()
+            ))
         })?;
-        let linv =
-            chol.l().try_inverse().ok_or_else(|| {
-                FemError::Solver("eigenvalues: singular projected stiffness".into())
-            })?;
+        let linv = chol
+            .l()
+            .try_inverse()
+            .ok_or_else(|| FemError::Solver("eigenvalues: singular projected stiffness".into()))?;
         let c = &linv * &br * linv.transpose();
         let eig = nalgebra::SymmetricEigen::new(0.5 * (&c + c.transpose()));
         let mut order: Vec<usize> = (0..q).collect();
