@@ -154,6 +154,9 @@ pub enum Totals {
     Only,
 }
 
+/// An equation: terms (node, dof 0–2, coefficient) and the line of its first data line.
+pub type Equation = (Vec<(usize, usize, f64)>, usize);
+
 /// A step's state: supports, loads (accumulated over the earlier steps) and output requests.
 #[derive(Clone, Debug, Default)]
 pub struct Step {
@@ -203,7 +206,7 @@ pub struct Model {
     /// Local axes per node (`*TRANSFORM`).
     pub transforms: BTreeMap<usize, Transform>,
     /// Equations (`*EQUATION`): terms (node, dof 0–2, coefficient) and the line.
-    pub equations: Vec<(Vec<(usize, usize, f64)>, usize)>,
+    pub equations: Vec<Equation>,
     /// Warnings: what is read but changes nothing, or is skipped (with its line).
     pub warnings: Vec<String>,
     /// The steps.

@@ -185,12 +185,13 @@ pub fn geometric_stiffness(points: &[IntegrationPoint], sigma: &[[f64; 6]]) -> D
         let m = [[s[0], s[3], s[5]], [s[3], s[1], s[4]], [s[5], s[4], s[2]]];
         for a in 0..n {
             for b in 0..n {
-                let mut h = 0.0;
-                for i in 0..3 {
-                    for j in 0..3 {
-                        h += p.g[a][i] * m[i][j] * p.g[b][j];
-                    }
-                }
+                let h: f64 = m
+                    .iter()
+                    .zip(&p.g[a])
+                    .map(|(row, ga)| {
+                        ga * (row[0] * p.g[b][0] + row[1] * p.g[b][1] + row[2] * p.g[b][2])
+                    })
+                    .sum();
                 for i in 0..3 {
                     k[(3 * a + i, 3 * b + i)] += p.dv * h;
                 }

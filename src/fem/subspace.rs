@@ -64,10 +64,10 @@ pub fn lowest_eigenpairs(
     // start block: the given vector, B's diagonal, unit vectors spread over the DOFs
     let mut x = vec![0.0; n * q];
     let mut diag = vec![0.0; n];
-    for c in 0..n {
+    for (c, d) in diag.iter_mut().enumerate() {
         for k in b.col_ptr[c]..b.col_ptr[c + 1] {
             if b.row_idx[k] == c {
-                diag[c] = b.values[k].abs();
+                *d = b.values[k].abs();
             }
         }
     }
