@@ -1,15 +1,17 @@
-//! Linear static analysis of a standard input deck: the subset of the Abaqus/CalculiX `.inp`
-//! format a linear static model of tetrahedra needs (`rodstudy solve DECK.inp`), so that the FEM
+//! Linear static, buckling and frequency analysis of a standard input deck: the subset of the
+//! Abaqus/CalculiX `.inp` format a linear model of tetrahedra needs (the table of `docs/solve.md`) (`rodstudy solve DECK.inp`), so that the FEM
 //! core can be run on the field's benchmarks (NAFEMS LE10: NAFEMS, "The Standard NAFEMS
 //! Benchmarks", TNSB Rev. 3, 1990; `pipeline/nafems_le10.py`) and on a user's own CalculiX or
 //! Abaqus model.
 //!
 //! * [`parse`]: lines into cards (keyword, parameters, data lines, line numbers);
-//! * [`model`]: cards into the model (nodes, C3D10/C3D4 elements, sets, material, section,
-//!   supports, loads, output requests per step); every other keyword, parameter or data form is
-//!   refused with its line number, never ignored;
-//! * [`solve`]: the model to [`crate::fem::StaticProblem`] and back (node-set values, reactions,
-//!   nodal stresses formed as CalculiX forms them, [`crate::fem::nodal_stress`]);
+//! * [`model`], read by [`cards`], [`mesh_cards`], [`load_cards`], [`output_cards`] and
+//!   [`constraint_cards`]: nodes, C3D10/C3D4 elements, sets, surfaces, materials, sections, local
+//!   axes, equations, supports, loads, output requests per step; every other keyword, parameter
+//!   or data form is refused with its line number (all of a deck's at once), never ignored;
+//! * [`system`] and [`solve`]: the element matrices, constraints and loads as ccx forms them, one
+//!   static, buckling or frequency solve per step, node-set values, RF = K u, nodal stresses and
+//!   strains ([`fields`]);
 //! * [`output`]: the JSON document and the VTU files.
 //!
 //! Reference for the format and its semantics: the CalculiX CrunchiX user's manual (ccx 2.20),
