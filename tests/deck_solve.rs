@@ -370,7 +370,7 @@ fn patch_test_uniform_tension() {
                 );
             }
         }
-        for el in &st.element_sets["EALL"].s {
+        for el in st.element_sets["EALL"].s.as_ref().unwrap() {
             for ip in el {
                 assert!((ip[0] - sigma).abs() < 1e-10 * sigma, "{ip:?}");
                 assert!(ip[1..].iter().all(|v| v.abs() < 1e-10 * sigma), "{ip:?}");
@@ -433,11 +433,9 @@ fn box_tension(sigma: f64) -> String {
     tet10[from..to].to_string()
 }
 
-/// (5) C3D4 is solved as a straight-sided C3D10 with its midside nodes added: a support on the
-/// corners of a face holds the added midside nodes of the face's edges too (as the linear edge of
-/// ccx's C3D4 does), so the patch test holds with supports given on corners only: uniform σ,
-/// u = σ L / E, reactions equal to the load. (Before, the added nodes were free, and the same
-/// deck gave σ_xx between 864 and 1108 for 1000 and u 1–2 % off.)
+/// (5) C3D4 is solved as ccx's linear tetrahedron (constant strain, one integration point): the
+/// patch test holds with supports on corners only: uniform σ, u = σ L / E, reactions equal to the
+/// load.
 #[test]
 fn a_c3d4_patch_test_holds_with_supports_on_corners_only() {
     let sigma = 100.0;
@@ -445,7 +443,7 @@ fn a_c3d4_patch_test_holds_with_supports_on_corners_only() {
     let text = box_c3d4(&box_tension(sigma));
     let model = read_deck_text(Path::new("box4.inp"), &text).unwrap();
     let st = &solve_model(&model, SolveOptions::default()).unwrap().steps[0];
-    for el in &st.element_sets["EALL"].s {
+    for el in st.element_sets["EALL"].s.as_ref().unwrap() {
         for ip in el {
             assert!((ip[0] - sigma).abs() < 1e-9 * sigma, "{ip:?}");
             assert!(ip[1..].iter().all(|v| v.abs() < 1e-9 * sigma), "{ip:?}");

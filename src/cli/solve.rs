@@ -1,5 +1,6 @@
-//! `rodstudy solve DECK.inp [--out DIR] [--json] [--extrapolation exact|calculix]`: linear static
-//! analysis of a CalculiX/Abaqus input deck (the subset in [`crate::deck`]).
+//! `rodstudy solve DECK.inp [--out DIR] [--json] [--extrapolation exact|calculix]`: linear static,
+//! buckling and frequency analysis of a CalculiX/Abaqus input deck (the subset of
+//! `docs/solve.md`, read by [`crate::deck`]). Warnings go to standard error and into the JSON.
 
 use crate::deck::{self, SolveOptions, output};
 use crate::fem::nodal_stress::Extrapolation;
@@ -18,10 +19,10 @@ enum ExtrapolationArg {
 
 #[derive(Args)]
 pub struct SolveArgs {
-    /// The input deck: *NODE, *ELEMENT (C3D10, C3D4), *NSET/*ELSET [GENERATE], *MATERIAL,
-    /// *ELASTIC, *DENSITY, *SOLID SECTION, *BOUNDARY, *STEP, *STATIC, *CLOAD, *DLOAD (P1-P4,
-    /// GRAV), *NODE PRINT, *EL PRINT, *NODE FILE, *EL FILE (U, S, RF), *END STEP, *HEADING.
-    /// Any other keyword is refused with its line number.
+    /// The input deck (CalculiX/Abaqus): C3D10 and C3D4 solids, several materials, *SURFACE,
+    /// *TRANSFORM, *EQUATION, *INCLUDE; *STATIC, *BUCKLE and *FREQUENCY steps with *BOUNDARY,
+    /// *CLOAD, *DLOAD (P1-P4, GRAV, CENTRIF), *DSLOAD; output U, S, E, RF. The accepted subset
+    /// is the table of docs/solve.md; everything else is refused, every line at once.
     deck: PathBuf,
     /// Folder for DECK.json and DECK_stepN.vtu (default: reports/solve/DECK).
     #[arg(long)]
@@ -42,8 +43,16 @@ pub fn run(args: SolveArgs) -> Result<i32> {
         ExtrapolationArg::Calculix => Extrapolation::CalculiX,
     };
     // the solve's refusals (a mechanism, an inverted element) name the deck, as its read's do
-    let sol = deck::solve_model(&model, SolveOptions { extrapolation })
-        .map_err(|e| anyhow::anyhow!("{}: {e}", args.deck.display()))?;
+    let sol =
+        deck::solve_model_at(&args.deck, &model, SolveOptions { extrapolation }).map_err(|e| {
+            match e {
+                crate::fem::FemError::Parse { .. } => anyhow::anyhow!("{e}"),
+                e => anyhow::anyhow!("{}: {e}", args.deck.display()),
+            }
+        })?;
+    for w in &sol.warnings {
+        eprintln!("warning: {w}");
+    }
     let stem = args
         .deck
         .file_stem()
@@ -68,8 +77,8 @@ pub fn run(args: SolveArgs) -> Result<i32> {
         "{}: {} nodes, {} elements, {} DOFs, {} step(s); wall {:.2} s; results in {}",
         args.deck.display(),
         sol.node_ids.len(),
-        sol.element_ids.len(),
-        sol.mesh.n_dofs(),
+        sol.elements.len(),
+        sol.dofs,
         sol.steps.len(),
         t.elapsed().as_secs_f64(),
         out.display()
@@ -82,6 +91,18 @@ pub fn run(args: SolveArgs) -> Result<i32> {
             st.residual_rel,
             st.applied_total
         );
+        if let Some(eig) = &st.eigen {
+            for (k, b) in eig.buckling_factors.iter().enumerate() {
+                outln!("  buckling factor {}: {b:.7e}", k + 1);
+            }
+            for (k, f) in eig.frequencies.iter().enumerate() {
+                outln!(
+                    "  frequency {}: {f:.7e} cycles/time (eigenvalue {:.7e})",
+                    k + 1,
+                    eig.eigenvalues[k]
+                );
+            }
+        }
         for (name, r) in &st.reaction_totals {
             outln!(
                 "  reaction total {name}: [{:.6e}, {:.6e}, {:.6e}]",

@@ -1,12 +1,18 @@
-//! The cards of a deck read into a [`Model`], keyword by keyword (the subset listed in
-//! [`super::model`]); every keyword, parameter and data form outside it is refused with its line.
+//! The cards of a deck read into a [`Model`], keyword by keyword (the subset of `docs/solve.md`):
+//! the dispatch, the parameters each keyword accepts, where it may stand, and the model-section
+//! and step-structure keywords. Loads and supports are in [`super::load_cards`], output requests
+//! in [`super::output_cards`], surfaces, local axes and equations in [`super::constraint_cards`].
+//!
+//! Every card is read even when an earlier one was refused, and every refusal is reported at
+//! once, each with its file and line (a refusal that makes later cards meaningless, such as an
+//! undefined set, is reported where it stands, and the cards that use it report their own line).
 
 use std::collections::BTreeSet;
 use std::path::Path;
 
 use super::model::*;
-use super::parse::{Card, error, int, load, num, push_unique, required};
-use crate::fem::error::Result;
+use super::parse::{Card, error, int, num, required};
+use crate::fem::error::{FemError, Result};
 
 /// Parameters each keyword accepts (any other is refused).
 fn allowed_params(keyword: &str) -> Option<&'static [&'static str]> {
@@ -16,558 +22,604 @@ fn allowed_params(keyword: &str) -> Option<&'static [&'static str]> {
         "ELEMENT" => &["TYPE", "ELSET"],
         "NSET" => &["NSET", "GENERATE"],
         "ELSET" => &["ELSET", "GENERATE"],
+        "SURFACE" => &["NAME", "TYPE"],
+        "TRANSFORM" => &["NSET", "TYPE"],
+        "EQUATION" => &[],
         "MATERIAL" => &["NAME"],
         "ELASTIC" => &["TYPE"],
+        "EXPANSION" => &["ZERO", "TYPE"],
+        "PHYSICAL CONSTANTS" => &["ABSOLUTE ZERO", "STEFAN BOLTZMANN", "NEWTON GRAVITY"],
         "SOLID SECTION" => &["ELSET", "MATERIAL"],
-        "BOUNDARY" => &["OP"],
-        "CLOAD" | "DLOAD" => &["OP"],
-        "STEP" => &["INC", "NLGEOM"],
-        "STATIC" => &["SOLVER"],
+        "BOUNDARY" => &["OP", "FIXED"],
+        "CLOAD" | "DLOAD" | "DSLOAD" => &["OP"],
+        "STEP" => &["INC", "INCF", "NLGEOM"],
+        "STATIC" => &["SOLVER", "DIRECT"],
+        "BUCKLE" => &["SOLVER"],
+        "FREQUENCY" => &["SOLVER", "STORAGE", "GLOBAL", "CYCMPC"],
+        "CONTROLS" => &["PARAMETERS", "RESET"],
+        "OUTPUT" => &["FREQUENCY"],
         "NODE PRINT" => &["NSET", "TOTALS", "FREQUENCY", "GLOBAL"],
         "EL PRINT" => &["ELSET", "TOTALS", "FREQUENCY", "GLOBAL"],
         "NODE FILE" | "EL FILE" => &["FREQUENCY", "OUTPUT", "GLOBAL"],
+        "SECTION PRINT" => &["SURFACE", "NAME", "FREQUENCY"],
         _ => return None,
     })
 }
 
-impl Model {
-    /// Builds the model from the cards of `path`.
-    pub fn from_cards(path: &Path, cards: &[Card]) -> Result<Model> {
-        let mut m = Model::default();
-        let mut material: Option<String> = None;
-        // supports and loads of the model section and of the steps so far
-        let mut state = Step::default();
-        let mut in_step = false;
-        let mut first_cload = true;
-        let mut first_dload = true;
-        // loads given in the current step: a repeat within the step adds to them (as ccx does), a
-        // repeat in a later step replaces the earlier step's value
-        let mut cloads_here = BTreeSet::new();
-        let mut pressures_here = BTreeSet::new();
-        let mut gravity_here = BTreeSet::new();
-        // output requests: the first card of a kind within a step replaces the requests of that
-        // kind; a step without one keeps the previous step's (ccx's manual, *NODE PRINT, *EL PRINT,
-        // *NODE FILE, *EL FILE)
-        let mut first_request = [true; 4];
-        let mut node_file: Vec<String> = Vec::new();
-        let mut el_file: Vec<String> = Vec::new();
-        for card in cards {
-            let kw = card.keyword.as_str();
-            let Some(allowed) = allowed_params(kw) else {
-                return Err(error(
-                    path,
-                    card.line,
-                    format!(
-                        "*{kw} is not supported (rodstudy solves linear static tet models: see \
-                         `rodstudy solve --help` for the keywords it reads)"
-                    ),
-                ));
-            };
-            if let Some((p, _)) = card
-                .params
-                .iter()
-                .find(|(p, _)| !allowed.contains(&p.as_str()))
-            {
-                return Err(error(
-                    path,
-                    card.line,
-                    format!("*{kw}: parameter {p} is not supported"),
-                ));
-            }
-            let step_kw = matches!(
-                kw,
-                "STATIC"
-                    | "CLOAD"
-                    | "DLOAD"
-                    | "NODE PRINT"
-                    | "EL PRINT"
-                    | "NODE FILE"
-                    | "EL FILE"
-                    | "END STEP"
-            );
-            if step_kw && !in_step {
-                return Err(error(path, card.line, format!("*{kw} outside a *STEP")));
-            }
-            if in_step
-                && matches!(
-                    kw,
-                    "NODE"
-                        | "ELEMENT"
-                        | "NSET"
-                        | "ELSET"
-                        | "MATERIAL"
-                        | "ELASTIC"
-                        | "DENSITY"
-                        | "SOLID SECTION"
-                        | "STEP"
-                )
-            {
-                return Err(error(
-                    path,
-                    card.line,
-                    format!("*{kw} inside a step (missing *END STEP?)"),
-                ));
-            }
-            if !matches!(kw, "ELASTIC" | "DENSITY") {
-                if kw != "MATERIAL" {
-                    material = None;
-                }
-            } else if material.is_none() {
-                return Err(error(path, card.line, format!("*{kw} outside a *MATERIAL")));
-            }
-            let needs_data = matches!(
-                kw,
-                "NSET"
-                    | "ELSET"
-                    | "ELASTIC"
-                    | "DENSITY"
-                    | "BOUNDARY"
-                    | "CLOAD"
-                    | "DLOAD"
-                    | "NODE PRINT"
-                    | "EL PRINT"
-            );
-            if needs_data && card.data.is_empty() {
-                return Err(error(path, card.line, format!("*{kw} without data lines")));
-            }
-            let max_data = match kw {
-                "MATERIAL" | "STEP" | "END STEP" => 0,
-                // a solid section may carry one data line (a thickness, unused for solids)
-                "SOLID SECTION" => 1,
-                _ => usize::MAX,
-            };
-            if card.data.len() > max_data {
-                return Err(error(
-                    path,
-                    card.data[max_data].line,
-                    format!("*{kw} takes no further data lines"),
-                ));
-            }
-            match kw {
-                "HEADING" => {}
-                "NODE" => m.read_nodes(path, card)?,
-                "ELEMENT" => m.read_elements(path, card)?,
-                "NSET" | "ELSET" => m.read_set(path, card)?,
-                "MATERIAL" => {
-                    let name = required(path, card, "NAME")?.to_ascii_uppercase();
-                    if m.materials.contains_key(&name) {
-                        return Err(error(
-                            path,
-                            card.line,
-                            format!("material {name} defined twice"),
-                        ));
-                    }
-                    m.materials.insert(
-                        name.clone(),
-                        MaterialDef {
-                            line: card.line,
-                            ..Default::default()
-                        },
-                    );
-                    material = Some(name);
-                }
-                "ELASTIC" => {
-                    if let Some(t) = card.param("TYPE")
-                        && !t.eq_ignore_ascii_case("ISO")
-                    {
-                        return Err(error(
-                            path,
-                            card.line,
-                            format!("*ELASTIC, TYPE={t}: only isotropic (TYPE=ISO) is supported"),
-                        ));
-                    }
-                    let d = &card.data[0];
-                    if card.data.len() > 1 || d.fields.len() > 3 {
-                        return Err(error(
-                            path,
-                            d.line,
-                            "temperature-dependent elastic constants are not supported",
-                        ));
-                    }
-                    let e = num(path, d, 0, "Young's modulus")?;
-                    let nu = num(path, d, 1, "Poisson's ratio")?;
-                    // a solid is stable (its strain energy positive) only for E > 0 and
-                    // −1 < ν < 0.5
-                    if e <= 0.0 {
-                        return Err(error(
-                            path,
-                            d.line,
-                            format!(
-                                "Young's modulus {e} is not positive: no material has E ≤ 0; \
-                                 the line is 'E, ν'"
-                            ),
-                        ));
-                    }
-                    if !(nu > -1.0 && nu < 0.5) {
-                        return Err(error(
-                            path,
-                            d.line,
-                            format!(
-                                "Poisson's ratio {nu} lies outside (−1, 0.5), where no stable \
-                                 solid lies; the line is 'E, ν'"
-                            ),
-                        ));
-                    }
-                    let mat = m
-                        .materials
-                        .get_mut(material.as_ref().expect("checked"))
-                        .expect("defined");
-                    mat.elastic = Some((e, nu));
-                }
-                "DENSITY" => {
-                    let d = &card.data[0];
-                    if card.data.len() > 1 || d.fields.len() > 2 {
-                        return Err(error(
-                            path,
-                            d.line,
-                            "temperature-dependent density is not supported",
-                        ));
-                    }
-                    let rho = num(path, d, 0, "density")?;
-                    if rho < 0.0 {
-                        return Err(error(
-                            path,
-                            d.line,
-                            format!("density {rho} is negative: a mass density is ≥ 0"),
-                        ));
-                    }
-                    let mat = m
-                        .materials
-                        .get_mut(material.as_ref().expect("checked"))
-                        .expect("defined");
-                    mat.density = Some(rho);
-                }
-                "SOLID SECTION" => {
-                    let elset = required(path, card, "ELSET")?.to_ascii_uppercase();
-                    let mat = required(path, card, "MATERIAL")?.to_ascii_uppercase();
-                    if !m.elsets.contains_key(&elset) {
-                        return Err(error(
-                            path,
-                            card.line,
-                            format!("element set {elset} is not defined"),
-                        ));
-                    }
-                    m.sections.push((elset, mat, card.line));
-                }
-                "BOUNDARY" => {
-                    if let Some(op) = card.param("OP")
-                        && !op.eq_ignore_ascii_case("MOD")
-                    {
-                        return Err(error(
-                            path,
-                            card.line,
-                            format!(
-                                "*BOUNDARY, OP={op}: only OP=MOD (supports carry over) is supported"
-                            ),
-                        ));
-                    }
-                    for d in &card.data {
-                        let (name, nodes) = m.node_target(path, d)?;
-                        let f1 = d
-                            .fields
-                            .get(1)
-                            .ok_or_else(|| error(path, d.line, "missing first dof"))?;
-                        let first = int(
-                            path,
-                            d.line,
-                            f1,
-                            "first dof (named supports such as ENCASTRE are not supported)",
-                        )?;
-                        let last = match d.fields.get(2) {
-                            Some(f) if !f.is_empty() => int(path, d.line, f, "last dof")?,
-                            _ => first,
-                        };
-                        let value = if d.fields.len() > 3 {
-                            num(path, d, 3, "prescribed value")?
-                        } else {
-                            0.0
-                        };
-                        if d.fields.len() > 4 {
-                            return Err(error(
-                                path,
-                                d.line,
-                                "a *BOUNDARY line is 'node|nset, first, last, value'",
-                            ));
-                        }
-                        if !(1..=3).contains(&first) || !(first..=3).contains(&last) {
-                            return Err(error(
-                                path,
-                                d.line,
-                                format!(
-                                    "dofs {first}..{last}: only displacements 1-3 exist on solid elements"
-                                ),
-                            ));
-                        }
-                        for &n in &nodes {
-                            for dof in first..=last {
-                                state.boundary.insert((n, (dof - 1) as usize), value);
-                            }
-                        }
-                        push_unique(state.supported_sets.entry(name).or_default(), nodes);
-                    }
-                }
-                "STEP" => {
-                    if let Some(v) = card.param("NLGEOM")
-                        && !v.eq_ignore_ascii_case("NO")
-                    {
-                        return Err(error(
-                            path,
-                            card.line,
-                            "*STEP, NLGEOM: only linear analysis is supported",
-                        ));
-                    }
-                    in_step = true;
-                    first_cload = true;
-                    first_dload = true;
-                    cloads_here.clear();
-                    pressures_here.clear();
-                    gravity_here.clear();
-                    first_request = [true; 4];
-                    state.line = card.line;
-                    state.static_seen = false;
-                }
-                "STATIC" => {
-                    if card.data.len() > 1 {
-                        return Err(error(
-                            path,
-                            card.data[1].line,
-                            "*STATIC takes one data line",
-                        ));
-                    }
-                    state.static_seen = true;
-                }
-                "CLOAD" => {
-                    if op_new(path, card)? && first_cload {
-                        state.cloads.clear();
-                    }
-                    first_cload = false;
-                    for d in &card.data {
-                        let (_, nodes) = m.node_target(path, d)?;
-                        let f1 = d
-                            .fields
-                            .get(1)
-                            .ok_or_else(|| error(path, d.line, "missing dof"))?;
-                        let dof = int(path, d.line, f1, "dof")?;
-                        if !(1..=3).contains(&dof) {
-                            return Err(error(
-                                path,
-                                d.line,
-                                format!("dof {dof}: only forces 1-3 exist on solid elements"),
-                            ));
-                        }
-                        let v = load(path, d, 2, "load")?;
-                        if d.fields.len() > 3 {
-                            return Err(error(
-                                path,
-                                d.line,
-                                "a *CLOAD line is 'node|nset, dof, value'",
-                            ));
-                        }
-                        for &n in &nodes {
-                            let key = (n, (dof - 1) as usize);
-                            if cloads_here.insert(key) {
-                                state.cloads.insert(key, v);
-                            } else {
-                                *state.cloads.get_mut(&key).expect("given in this step") += v;
-                            }
-                        }
-                    }
-                }
-                "DLOAD" => {
-                    if op_new(path, card)? && first_dload {
-                        state.pressures.clear();
-                        state.gravity.clear();
-                    }
-                    first_dload = false;
-                    for d in &card.data {
-                        let elements = m.element_target(path, d)?;
-                        let label = d
-                            .fields
-                            .get(1)
-                            .map(|s| s.to_ascii_uppercase())
-                            .unwrap_or_default();
-                        match label.as_str() {
-                            "P1" | "P2" | "P3" | "P4" => {
-                                let face = (label.as_bytes()[1] - b'1') as usize;
-                                let p = load(path, d, 2, "pressure")?;
-                                if d.fields.len() > 3 {
-                                    return Err(error(
-                                        path,
-                                        d.line,
-                                        "a pressure line is 'element|elset, Pk, p'",
-                                    ));
-                                }
-                                for &e in &elements {
-                                    if pressures_here.insert((e, face)) {
-                                        state.pressures.insert((e, face), p);
-                                    } else {
-                                        *state.pressures.get_mut(&(e, face)).expect("given") += p;
-                                    }
-                                }
-                            }
-                            "GRAV" => {
-                                let g = load(path, d, 2, "gravity magnitude")?;
-                                let dir = [
-                                    num(path, d, 3, "nx")?,
-                                    num(path, d, 4, "ny")?,
-                                    num(path, d, 5, "nz")?,
-                                ];
-                                let n =
-                                    (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
-                                if n == 0.0 || !n.is_finite() || d.fields.len() > 6 {
-                                    return Err(error(
-                                        path,
-                                        d.line,
-                                        "a GRAV line is 'elset, GRAV, g, nx, ny, nz' with a non-zero direction",
-                                    ));
-                                }
-                                let this = Grav {
-                                    g,
-                                    dir: dir.map(|v| v / n),
-                                };
-                                for &e in &elements {
-                                    let grav = if gravity_here.insert(e) {
-                                        this
-                                    } else {
-                                        state.gravity[&e].plus(&this)
-                                    };
-                                    state.gravity.insert(e, grav);
-                                }
-                            }
-                            _ => {
-                                return Err(error(
-                                    path,
-                                    d.line,
-                                    format!(
-                                        "*DLOAD label '{label}' is not supported (P1-P4 on C3D10 faces, GRAV)"
-                                    ),
-                                ));
-                            }
-                        }
-                    }
-                }
-                "NODE PRINT" | "EL PRINT" | "NODE FILE" | "EL FILE" => {
-                    let mut vars = Vec::new();
-                    for d in &card.data {
-                        for f in &d.fields {
-                            let v = f.to_ascii_uppercase();
-                            let ok = match kw {
-                                "EL PRINT" => v == "S",
-                                _ => matches!(v.as_str(), "U" | "S" | "RF"),
-                            };
-                            if !ok {
-                                return Err(error(
-                                    path,
-                                    d.line,
-                                    format!(
-                                        "*{kw}: output variable '{f}' is not supported (U, S, RF)"
-                                    ),
-                                ));
-                            }
-                            if !vars.contains(&v) {
-                                vars.push(v);
-                            }
-                        }
-                    }
-                    let kind = ["NODE PRINT", "EL PRINT", "NODE FILE", "EL FILE"]
-                        .iter()
-                        .position(|k| *k == kw)
-                        .expect("one of the four");
-                    if std::mem::replace(&mut first_request[kind], false) {
-                        match kind {
-                            0 => state.node_print.clear(),
-                            1 => state.el_print.clear(),
-                            2 => node_file.clear(),
-                            _ => el_file.clear(),
-                        }
-                    }
-                    match kw {
-                        "NODE PRINT" => {
-                            let set = required(path, card, "NSET")?.to_ascii_uppercase();
-                            if !m.nsets.contains_key(&set) {
-                                return Err(error(
-                                    path,
-                                    card.line,
-                                    format!("node set {set} is not defined"),
-                                ));
-                            }
-                            let totals = card
-                                .param("TOTALS")
-                                .is_some_and(|t| !t.eq_ignore_ascii_case("NO"));
-                            state.node_print.push((set, vars, totals));
-                        }
-                        "EL PRINT" => {
-                            let set = required(path, card, "ELSET")?.to_ascii_uppercase();
-                            if !m.elsets.contains_key(&set) {
-                                return Err(error(
-                                    path,
-                                    card.line,
-                                    format!("element set {set} is not defined"),
-                                ));
-                            }
-                            state.el_print.push((set, vars));
-                        }
-                        _ => {
-                            let list = if kind == 2 {
-                                &mut node_file
-                            } else {
-                                &mut el_file
-                            };
-                            for v in vars {
-                                if !list.contains(&v) {
-                                    list.push(v);
-                                }
-                            }
-                        }
-                    }
-                    state.file_vars = node_file.clone();
-                    for v in &el_file {
-                        if !state.file_vars.contains(v) {
-                            state.file_vars.push(v.clone());
-                        }
-                    }
-                }
-                "END STEP" => {
-                    if !state.static_seen {
-                        return Err(error(
-                            path,
-                            card.line,
-                            "a step without *STATIC (only linear static steps are supported)",
-                        ));
-                    }
-                    m.steps.push(state.clone());
-                    in_step = false;
-                }
-                _ => unreachable!("allowed_params covers the keywords"),
-            }
+/// What ccx does that rodstudy does not, for the message of a refused keyword.
+fn why_refused(keyword: &str) -> &'static str {
+    match keyword {
+        "CONTACT PAIR"
+        | "SURFACE INTERACTION"
+        | "SURFACE BEHAVIOR"
+        | "FRICTION"
+        | "TIE"
+        | "CONTACT FILE"
+        | "CONTACT PRINT"
+        | "CONTACT OUTPUT" => "contact is not supported",
+        "COUPLING" | "KINEMATIC" | "DISTRIBUTING" | "RIGID BODY" => {
+            "couplings to a reference node are not supported: load the nodes directly \
+             (*CLOAD) or tie them with *EQUATION"
         }
-        if in_step {
-            return Err(error(path, state.line, "*STEP without *END STEP"));
+        "PLASTIC" | "HYPERELASTIC" | "CREEP" | "DEFORMATION PLASTICITY" | "USER MATERIAL" => {
+            "nonlinear materials are not supported (linear elastic only)"
         }
-        if m.elements.is_empty() {
-            return Err(error(
-                path,
-                0,
-                "no C3D10/C3D4 elements: a deck needs *NODE and *ELEMENT, TYPE=C3D10 (or C3D4) \
-                 cards (an empty or cut-off file has none)",
-            ));
+        "TEMPERATURE"
+        | "INITIAL CONDITIONS"
+        | "HEAT TRANSFER"
+        | "COUPLED TEMPERATURE-DISPLACEMENT"
+        | "CONDUCTIVITY"
+        | "SPECIFIC HEAT"
+        | "FILM"
+        | "RADIATE"
+        | "DFLUX"
+        | "CFLUX" => "thermal analysis is not supported",
+        "DYNAMIC" | "MODAL DYNAMIC" | "STEADY STATE DYNAMICS" | "VISCO" | "AMPLITUDE" => {
+            "only *STATIC, *BUCKLE and *FREQUENCY steps are supported"
         }
-        if m.steps.is_empty() {
-            return Err(error(
-                path,
-                0,
-                "no *STEP: a deck needs a *STEP with *STATIC, its loads and *END STEP",
-            ));
+        "SHELL SECTION" | "BEAM SECTION" | "MEMBRANE SECTION" => {
+            "only solid elements (C3D10, C3D4) are supported"
         }
-        Ok(m)
+        "REFINE MESH" => "mesh refinement is not supported: refine the mesh before",
+        "ORIENTATION" => "orientations (anisotropic materials) are not supported",
+        _ => "see docs/solve.md for the keywords rodstudy reads",
     }
 }
 
-fn op_new(path: &Path, card: &Card) -> Result<bool> {
-    match card.param("OP") {
-        None => Ok(false),
-        Some(v) if v.eq_ignore_ascii_case("MOD") => Ok(false),
-        Some(v) if v.eq_ignore_ascii_case("NEW") => Ok(true),
-        Some(v) => Err(error(path, card.line, format!("OP={v}: NEW or MOD"))),
+/// The state of the reading: the current material, the step being read and what its first
+/// cards of a kind replace.
+#[derive(Default)]
+pub(super) struct Reader {
+    pub(super) material: Option<String>,
+    /// Supports and loads of the model section and of the steps so far.
+    pub(super) state: Step,
+    pub(super) in_step: bool,
+    pub(super) steps_begun: usize,
+    pub(super) first_cload: bool,
+    pub(super) first_dload: bool,
+    /// Loads given in the current step: a repeat within the step adds to them (as ccx does).
+    pub(super) cloads_here: BTreeSet<(usize, usize)>,
+    pub(super) pressures_here: BTreeSet<(usize, usize)>,
+    pub(super) gravity_here: BTreeSet<usize>,
+    pub(super) centrif_here: BTreeSet<usize>,
+    pub(super) first_request: [bool; 4],
+    pub(super) node_file: Vec<String>,
+    pub(super) el_file: Vec<String>,
+}
+
+/// Keywords of a step only.
+const STEP_ONLY: &[&str] = &[
+    "STATIC",
+    "BUCKLE",
+    "FREQUENCY",
+    "CONTROLS",
+    "CLOAD",
+    "DLOAD",
+    "DSLOAD",
+    "NODE PRINT",
+    "EL PRINT",
+    "NODE FILE",
+    "EL FILE",
+    "SECTION PRINT",
+    "OUTPUT",
+    "END STEP",
+];
+
+/// Keywords of the model section only.
+const MODEL_ONLY: &[&str] = &[
+    "NODE",
+    "ELEMENT",
+    "NSET",
+    "ELSET",
+    "SURFACE",
+    "TRANSFORM",
+    "EQUATION",
+    "MATERIAL",
+    "ELASTIC",
+    "DENSITY",
+    "EXPANSION",
+    "PHYSICAL CONSTANTS",
+    "SOLID SECTION",
+    "STEP",
+];
+
+impl Model {
+    /// Builds the model from the cards of `path`; all refusals at once.
+    pub fn from_cards(path: &Path, cards: &[Card]) -> Result<Model> {
+        let mut m = Model::default();
+        let mut r = Reader::default();
+        let mut refusals: Vec<FemError> = Vec::new();
+        for card in cards {
+            if let Err(e) = m.read_card(&card.file, card, &mut r) {
+                refusals.push(e);
+            }
+        }
+        if r.in_step {
+            refusals.push(error(path, r.state.line, "*STEP without *END STEP"));
+        }
+        if refusals.is_empty() {
+            if m.elements.is_empty() {
+                refusals.push(error(
+                    path,
+                    0,
+                    "no C3D10/C3D4 elements: a deck needs *NODE and *ELEMENT, TYPE=C3D10 (or \
+                     C3D4) cards (an empty or cut-off file has none)",
+                ));
+            } else if m.steps.is_empty() {
+                refusals.push(error(
+                    path,
+                    0,
+                    "no *STEP: a deck needs a *STEP with *STATIC, *BUCKLE or *FREQUENCY, its \
+                     loads and *END STEP",
+                ));
+            }
+        }
+        combine(refusals).map(|()| m)
+    }
+
+    fn read_card(&mut self, path: &Path, card: &Card, r: &mut Reader) -> Result<()> {
+        let m = self;
+        let kw = card.keyword.as_str();
+        let Some(allowed) = allowed_params(kw) else {
+            return Err(error(
+                path,
+                card.line,
+                format!("*{kw} is not supported ({})", why_refused(kw)),
+            ));
+        };
+        if let Some((p, _)) = card
+            .params
+            .iter()
+            .find(|(p, _)| !allowed.contains(&p.as_str()))
+        {
+            return Err(error(
+                path,
+                card.line,
+                format!("*{kw}: parameter {p} is not supported"),
+            ));
+        }
+        if STEP_ONLY.contains(&kw) && !r.in_step {
+            return Err(error(path, card.line, format!("*{kw} outside a *STEP")));
+        }
+        if r.in_step && MODEL_ONLY.contains(&kw) {
+            return Err(error(
+                path,
+                card.line,
+                format!("*{kw} inside a step (missing *END STEP?)"),
+            ));
+        }
+        if !matches!(kw, "ELASTIC" | "DENSITY" | "EXPANSION") {
+            if kw != "MATERIAL" {
+                r.material = None;
+            }
+        } else if r.material.is_none() {
+            return Err(error(path, card.line, format!("*{kw} outside a *MATERIAL")));
+        }
+        let needs_data = matches!(
+            kw,
+            "NSET"
+                | "ELSET"
+                | "SURFACE"
+                | "TRANSFORM"
+                | "EQUATION"
+                | "ELASTIC"
+                | "DENSITY"
+                | "BOUNDARY"
+                | "CLOAD"
+                | "DLOAD"
+                | "DSLOAD"
+                | "NODE PRINT"
+                | "EL PRINT"
+                | "BUCKLE"
+                | "FREQUENCY"
+        );
+        if needs_data && card.data.is_empty() {
+            return Err(error(path, card.line, format!("*{kw} without data lines")));
+        }
+        let max_data = match kw {
+            "MATERIAL" | "STEP" | "END STEP" | "OUTPUT" | "PHYSICAL CONSTANTS" => 0,
+            // a solid section may carry one data line (a thickness, unused for solids)
+            "SOLID SECTION" | "STATIC" | "BUCKLE" | "FREQUENCY" | "TRANSFORM" => 1,
+            _ => usize::MAX,
+        };
+        if card.data.len() > max_data {
+            return Err(error(
+                path,
+                card.data[max_data].line,
+                format!("*{kw} takes no further data lines"),
+            ));
+        }
+        match kw {
+            "HEADING" => Ok(()),
+            "NODE" => m.read_nodes(path, card),
+            "ELEMENT" => m.read_elements(path, card),
+            "NSET" | "ELSET" => m.read_set(path, card),
+            "SURFACE" => m.read_surface(path, card),
+            "TRANSFORM" => m.read_transform(path, card),
+            "EQUATION" => m.read_equation(path, card),
+            "MATERIAL" => {
+                let name = required(path, card, "NAME")?.to_ascii_uppercase();
+                if m.materials.contains_key(&name) {
+                    return Err(error(
+                        path,
+                        card.line,
+                        format!("material {name} defined twice"),
+                    ));
+                }
+                m.materials.insert(
+                    name.clone(),
+                    MaterialDef {
+                        line: card.line,
+                        file: card.file.clone(),
+                        ..Default::default()
+                    },
+                );
+                r.material = Some(name);
+                Ok(())
+            }
+            "ELASTIC" => {
+                let (e, nu) = read_elastic(path, card)?;
+                m.current_material(r).elastic = Some((e, nu));
+                Ok(())
+            }
+            "DENSITY" => {
+                let d = &card.data[0];
+                if card.data.len() > 1 || d.fields.len() > 2 {
+                    return Err(error(
+                        path,
+                        d.line,
+                        "temperature-dependent density is not supported",
+                    ));
+                }
+                let rho = num(path, d, 0, "density")?;
+                if rho < 0.0 {
+                    return Err(error(
+                        path,
+                        d.line,
+                        format!("density {rho} is negative: a mass density is ≥ 0"),
+                    ));
+                }
+                m.current_material(r).density = Some(rho);
+                Ok(())
+            }
+            "EXPANSION" | "PHYSICAL CONSTANTS" => {
+                m.warnings.push(format!(
+                    "{}:{}: *{kw} read and not used: it acts only with temperatures, and \
+                     thermal loads are not supported (none is given, so it changes nothing)",
+                    path.display(),
+                    card.line
+                ));
+                Ok(())
+            }
+            "SOLID SECTION" => {
+                let elset = required(path, card, "ELSET")?.to_ascii_uppercase();
+                let mat = required(path, card, "MATERIAL")?.to_ascii_uppercase();
+                if !m.elsets.contains_key(&elset) {
+                    return Err(error(
+                        path,
+                        card.line,
+                        format!("element set {elset} is not defined"),
+                    ));
+                }
+                m.sections.push(Section {
+                    elset,
+                    material: mat,
+                    line: card.line,
+                    file: card.file.clone(),
+                });
+                Ok(())
+            }
+            "BOUNDARY" => m.read_boundary(path, card, r),
+            "CLOAD" => m.read_cload(path, card, r),
+            "DLOAD" | "DSLOAD" => m.read_dload(path, card, r),
+            "STEP" => {
+                if let Some(v) = card.param("NLGEOM")
+                    && !v.eq_ignore_ascii_case("NO")
+                {
+                    return Err(error(
+                        path,
+                        card.line,
+                        "*STEP, NLGEOM: only linear analysis is supported (NLGEOM=NO)",
+                    ));
+                }
+                r.in_step = true;
+                r.steps_begun += 1;
+                r.first_cload = true;
+                r.first_dload = true;
+                r.cloads_here.clear();
+                r.pressures_here.clear();
+                r.gravity_here.clear();
+                r.centrif_here.clear();
+                r.first_request = [true; 4];
+                r.state.line = card.line;
+                r.state.analysis = None;
+                Ok(())
+            }
+            "STATIC" | "BUCKLE" | "FREQUENCY" => {
+                if r.state.analysis.is_some() {
+                    return Err(error(
+                        path,
+                        card.line,
+                        "a second analysis card in one step: one of *STATIC, *BUCKLE, \
+                         *FREQUENCY per step",
+                    ));
+                }
+                r.state.analysis = Some(read_analysis(path, card, &mut m.warnings)?);
+                Ok(())
+            }
+            "CONTROLS" => {
+                m.warnings.push(format!(
+                    "{}:{}: *CONTROLS read and not used: it tunes the increments and the \
+                     equilibrium iterations of a nonlinear step; a linear step is solved in one \
+                     increment without iterations, so it changes nothing",
+                    path.display(),
+                    card.line
+                ));
+                Ok(())
+            }
+            "OUTPUT" => {
+                if let Some(f) = card.param("FREQUENCY") {
+                    int(path, card.line, f, "FREQUENCY")?;
+                }
+                Ok(())
+            }
+            "NODE PRINT" | "EL PRINT" | "NODE FILE" | "EL FILE" => {
+                m.read_output_request(path, card, r)
+            }
+            "SECTION PRINT" => {
+                m.warnings.push(format!(
+                    "{}:{}: *SECTION PRINT skipped: section forces and moments are not computed",
+                    path.display(),
+                    card.line
+                ));
+                Ok(())
+            }
+            "END STEP" => {
+                if r.state.analysis.is_none() {
+                    return Err(error(
+                        path,
+                        card.line,
+                        "a step without *STATIC, *BUCKLE or *FREQUENCY",
+                    ));
+                }
+                m.steps.push(r.state.clone());
+                r.in_step = false;
+                Ok(())
+            }
+            _ => unreachable!("allowed_params covers the keywords"),
+        }
+    }
+
+    fn current_material(&mut self, r: &Reader) -> &mut MaterialDef {
+        self.materials
+            .get_mut(r.material.as_ref().expect("checked"))
+            .expect("defined")
+    }
+}
+
+/// All refusals as one error: the first's file and line, the others' each on a line of its own.
+fn combine(mut refusals: Vec<FemError>) -> Result<()> {
+    if refusals.is_empty() {
+        return Ok(());
+    }
+    let n = refusals.len();
+    let first = refusals.remove(0);
+    if n == 1 {
+        return Err(first);
+    }
+    match first {
+        FemError::Parse {
+            path,
+            line,
+            message,
+        } => {
+            let mut message = message;
+            for e in refusals {
+                message.push('\n');
+                message.push_str(&e.to_string());
+            }
+            message.push_str(&format!("\n({n} refusals in all)"));
+            Err(FemError::Parse {
+                path,
+                line,
+                message,
+            })
+        }
+        e => Err(e),
+    }
+}
+
+fn read_elastic(path: &Path, card: &Card) -> Result<(f64, f64)> {
+    if let Some(t) = card.param("TYPE")
+        && !t.eq_ignore_ascii_case("ISO")
+    {
+        return Err(error(
+            path,
+            card.line,
+            format!("*ELASTIC, TYPE={t}: only isotropic (TYPE=ISO) is supported"),
+        ));
+    }
+    let d = &card.data[0];
+    if card.data.len() > 1 || d.fields.len() > 3 {
+        return Err(error(
+            path,
+            d.line,
+            "temperature-dependent elastic constants are not supported",
+        ));
+    }
+    let e = num(path, d, 0, "Young's modulus")?;
+    let nu = num(path, d, 1, "Poisson's ratio")?;
+    // a solid is stable (its strain energy positive) only for E > 0 and −1 < ν < 0.5
+    if e <= 0.0 {
+        return Err(error(
+            path,
+            d.line,
+            format!(
+                "Young's modulus {e} is not positive: no material has E ≤ 0; the line is 'E, ν'"
+            ),
+        ));
+    }
+    if !(nu > -1.0 && nu < 0.5) {
+        return Err(error(
+            path,
+            d.line,
+            format!(
+                "Poisson's ratio {nu} lies outside (−1, 0.5), where no stable solid lies; the \
+                 line is 'E, ν'"
+            ),
+        ));
+    }
+    Ok((e, nu))
+}
+
+/// `*STATIC` (its data line: increments, unused by a linear step), `*BUCKLE` (`modes[,
+/// accuracy[, Lanczos vectors[, iterations]]]`), `*FREQUENCY` (`modes[, lower[, upper]]`).
+fn read_analysis(path: &Path, card: &Card, warnings: &mut Vec<String>) -> Result<Analysis> {
+    if let Some(s) = card.param("SOLVER") {
+        // the solver of the linear equations: all give the same solution to round-off
+        let known = [
+            "SPOOLES",
+            "PARDISO",
+            "PASTIX",
+            "SPARSE",
+            "ITERATIVE SCALING",
+            "ITERATIVE CHOLESKY",
+            "DEFAULT",
+        ];
+        if !known.iter().any(|k| s.eq_ignore_ascii_case(k)) {
+            return Err(error(
+                path,
+                card.line,
+                format!("SOLVER={s}: unknown solver"),
+            ));
+        }
+    }
+    match card.keyword.as_str() {
+        "STATIC" => {
+            if card.has("DIRECT") {
+                warnings.push(format!(
+                    "{}:{}: *STATIC, DIRECT (fixed increments) changes nothing: a linear step \
+                     is solved in one increment",
+                    path.display(),
+                    card.line
+                ));
+            }
+            Ok(Analysis::Static)
+        }
+        "BUCKLE" => {
+            let d = &card.data[0];
+            if d.fields.len() > 4 {
+                return Err(error(
+                    path,
+                    d.line,
+                    "a *BUCKLE line is 'modes[, accuracy, ncv, iterations]'",
+                ));
+            }
+            let modes = int(path, d.line, &d.fields[0], "number of buckling factors")?;
+            if !(1..=100).contains(&modes) {
+                return Err(error(
+                    path,
+                    d.line,
+                    format!("{modes} buckling factors: ask for 1 to 100"),
+                ));
+            }
+            let accuracy = match d.fields.get(1).filter(|f| !f.is_empty()) {
+                Some(_) => num(path, d, 1, "accuracy")?,
+                None => 0.01,
+            };
+            if !(accuracy > 0.0 && accuracy < 1.0) {
+                return Err(error(
+                    path,
+                    d.line,
+                    format!("accuracy {accuracy}: 0 < accuracy < 1"),
+                ));
+            }
+            Ok(Analysis::Buckle {
+                modes: modes as usize,
+                accuracy,
+            })
+        }
+        _ => {
+            if card
+                .param("STORAGE")
+                .is_some_and(|v| !v.eq_ignore_ascii_case("NO"))
+            {
+                return Err(error(
+                    path,
+                    card.line,
+                    "*FREQUENCY, STORAGE=YES is not supported",
+                ));
+            }
+            if card
+                .param("CYCMPC")
+                .is_some_and(|v| !v.eq_ignore_ascii_case("INACTIVE"))
+            {
+                return Err(error(
+                    path,
+                    card.line,
+                    "*FREQUENCY, CYCMPC: cyclic symmetry is not supported",
+                ));
+            }
+            let d = card
+                .data
+                .first()
+                .ok_or_else(|| error(path, card.line, "*FREQUENCY without its data line"))?;
+            if d.fields.len() > 3 {
+                return Err(error(
+                    path,
+                    d.line,
+                    "a *FREQUENCY line is 'modes[, lower, upper]' (cycles/time)",
+                ));
+            }
+            let modes = int(path, d.line, &d.fields[0], "number of frequencies")?;
+            if !(1..=100).contains(&modes) {
+                return Err(error(
+                    path,
+                    d.line,
+                    format!("{modes} frequencies: ask for 1 to 100"),
+                ));
+            }
+            let lower = match d.fields.get(1).filter(|f| !f.is_empty()) {
+                Some(_) => num(path, d, 1, "lower frequency")?,
+                None => 0.0,
+            };
+            if lower > 0.0 {
+                warnings.push(format!(
+                    "{}:{}: *FREQUENCY lower bound {lower} read as the shift: the lowest \
+                     frequencies are computed and the step is refused if one is below it",
+                    path.display(),
+                    d.line
+                ));
+            }
+            let upper = match d.fields.get(2).filter(|f| !f.is_empty()) {
+                Some(_) => Some(num(path, d, 2, "upper frequency")?),
+                None => None,
+            };
+            Ok(Analysis::Frequency {
+                modes: modes as usize,
+                lower,
+                upper,
+            })
+        }
     }
 }

@@ -11,12 +11,13 @@ impl Model {
     pub(super) fn read_nodes(&mut self, path: &Path, card: &Card) -> Result<()> {
         let mut added = Vec::new();
         for d in &card.data {
-            if d.fields.len() != 4 {
+            // `id, x, y` is read with z = 0, as ccx and Abaqus read it
+            if !(3..=4).contains(&d.fields.len()) {
                 return Err(error(
                     path,
                     d.line,
                     format!(
-                        "a node line is 'id, x, y, z': found {} fields",
+                        "a node line is 'id, x, y[, z]': found {} fields",
                         d.fields.len()
                     ),
                 ));
@@ -25,7 +26,11 @@ impl Model {
             let p = [
                 coordinate(path, d, 1, "x")?,
                 coordinate(path, d, 2, "y")?,
-                coordinate(path, d, 3, "z")?,
+                if d.fields.len() == 4 {
+                    coordinate(path, d, 3, "z")?
+                } else {
+                    0.0
+                },
             ];
             if self.node_index.insert(id, self.nodes.len()).is_some() {
                 return Err(error(path, d.line, format!("node {id} defined twice")));
@@ -46,24 +51,19 @@ impl Model {
     pub(super) fn read_elements(&mut self, path: &Path, card: &Card) -> Result<()> {
         let ty = required(path, card, "TYPE")?.to_ascii_uppercase();
         let (kind, n) = match ty.as_str() {
-            "C3D10" => (ElementKind::C3d10, 10),
-            "C3D4" => (ElementKind::C3d4, 4),
+            "C3D10" => (ElementKind::Tet10, 10),
+            "C3D4" => (ElementKind::Tet4, 4),
             _ => {
                 return Err(error(
                     path,
                     card.line,
-                    format!("element type {ty} is not supported (C3D10, C3D4)"),
+                    format!(
+                        "element type {ty} is not supported (solid tetrahedra C3D10 and C3D4 \
+                         only; hexahedra such as C3D20/C3D8, shells and beams are refused)"
+                    ),
                 ));
             }
         };
-        if self.kind.is_some_and(|k| k != kind) {
-            return Err(error(
-                path,
-                card.line,
-                "a deck mixing C3D4 and C3D10 is not supported",
-            ));
-        }
-        self.kind = Some(kind);
         let mut added = Vec::new();
         let mut pending: Vec<i64> = Vec::new();
         let mut start = 0;
@@ -143,6 +143,7 @@ impl Model {
                 added.push(self.elements.len());
                 self.elements.push(Element {
                     id,
+                    kind,
                     nodes,
                     line: start,
                 });

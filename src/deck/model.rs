@@ -1,59 +1,32 @@
-//! The model a deck describes: nodes, tetrahedra, sets, material, section, supports, loads and
-//! output requests per step, with the line each came from. Every keyword, parameter and data form
-//! outside the subset below is refused with its line number.
+//! The model a deck describes: nodes, elements, sets, surfaces, materials and sections, local axes
+//! (`*TRANSFORM`), equations, supports, loads and output requests per step, with the line each
+//! came from. The accepted subset, keyword by keyword with its parameters and what is refused, is
+//! the table of `docs/solve.md`; [`super::cards`] reads it and refuses everything else with its
+//! line (all refusals of a deck at once).
 //!
-//! Keywords (CalculiX CrunchiX user's manual, ccx 2.20, chapter "Input deck format", one section
-//! per keyword; the Abaqus Keywords Reference has the same cards):
-//! * `*HEADING` (data ignored);
-//! * `*NODE` [NSET=]: `id, x, y, z`;
-//! * `*ELEMENT, TYPE=C3D10|C3D4` [ELSET=]: `id, n1, ..., n10` (continued on the next line when it
-//!   does not fit). C3D10's node order is VTK's tetra10 order (corners, then edges 1-2, 2-3, 3-1,
-//!   1-4, 2-4, 3-4; manual, "C3D10"). C3D4 is solved as a straight-sided C3D10 (its midside nodes
-//!   added, internal): more accurate than ccx's linear C3D4, not the same numbers. A deck mixing
-//!   the two is refused;
-//! * `*NSET, NSET=` / `*ELSET, ELSET=` [GENERATE]: ids or names of sets defined before, or with
-//!   GENERATE `first, last[, step]`;
-//! * `*MATERIAL, NAME=`, `*ELASTIC` [TYPE=ISO]: `E, ν`; `*DENSITY`: `ρ`;
-//! * `*SOLID SECTION, ELSET=, MATERIAL=`: every element in exactly one section; all sections of one
-//!   elastic material (E, ν) — densities may differ;
-//! * `*BOUNDARY` [OP=MOD]: `node|nset, first dof[, last dof[, value]]`, dofs 1–3;
-//! * `*STEP` [INC=, NLGEOM=NO], `*STATIC` [SOLVER=] (its data line ignored: linear), `*END STEP`;
-//! * `*CLOAD` [OP=MOD|NEW]: `node|nset, dof, value`;
-//! * `*DLOAD` [OP=MOD|NEW]: `element|elset, Pk, p` (uniform pressure on face k, positive into the
-//!   element; faces by corners as in the manual, "C3D10": P1 = 1-2-3, P2 = 1-4-2, P3 = 2-4-3,
-//!   P4 = 3-4-1) or `element|elset, GRAV, g, nx, ny, nz` (body force ρ g n per volume);
-//! * `*NODE PRINT, NSET=` [TOTALS=, FREQUENCY=, GLOBAL=]: U, S, RF; `*EL PRINT, ELSET=`
-//!   [FREQUENCY=, TOTALS=NO, GLOBAL=]: S (at the integration points); `*NODE FILE`, `*EL FILE`
-//!   [FREQUENCY=, OUTPUT=, GLOBAL=]: U, S, RF (the fields of the VTU file).
-//!
-//! Step semantics as ccx's (checked against ccx 2.20): supports and loads carry over from step to
-//! step; a load on a node and dof (face, for *DLOAD; element, for GRAV) given again within the same
-//! step adds to the first (two lines, two cards, or a node in two loaded sets), given in a later
-//! step it replaces the earlier step's value; a repeated support replaces the earlier one; OP=NEW on
-//! the first *CLOAD (*DLOAD) of a step removes all earlier concentrated (distributed) loads. The
-//! first *NODE PRINT (*EL PRINT, *NODE FILE, *EL FILE) of a step replaces the requests of that kind,
-//! and a step without one keeps the previous step's. Numbers must be finite (`nan`, `inf` and
-//! overflows are refused with their line), and physical: E > 0, −1 < ν < 0.5, ρ ≥ 0, a load
-//! (force, pressure, gravity) at most [`super::parse::MAX_LOAD`] in magnitude, a coordinate at
-//! most [`super::parse::MAX_COORDINATE`]; an element lists distinct nodes, its corners at distinct
-//! places. Set names are case-insensitive (kept upper-cased, as ccx prints them).
+//! Semantics as ccx's (CalculiX CrunchiX user's manual, ccx 2.20, one section per keyword;
+//! checked against ccx 2.20): supports and loads carry over from step to step; a load on a node
+//! and dof (face, for pressure; element, for GRAV and CENTRIF) given again within the same step
+//! adds to the first, given in a later step it replaces the earlier step's value; a repeated
+//! support replaces the earlier one; OP=NEW on the first *CLOAD (*DLOAD/*DSLOAD) of a step removes
+//! all earlier concentrated (distributed) loads. The first *NODE PRINT (*EL PRINT, *NODE FILE,
+//! *EL FILE) of a step replaces the requests of that kind, and a step without one keeps the
+//! previous step's. Numbers must be finite and physical (E > 0, −1 < ν < 0.5, ρ ≥ 0, a load at
+//! most [`super::parse::MAX_LOAD`], a coordinate at most [`super::parse::MAX_COORDINATE`]); an
+//! element lists distinct nodes, its corners at distinct places. Set names are case-insensitive
+//! (kept upper-cased, as ccx prints them).
 
 use std::collections::{BTreeMap, HashMap};
 
-/// Element kind of the deck.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ElementKind {
-    /// C3D10.
-    C3d10,
-    /// C3D4 (solved as straight-sided C3D10).
-    C3d4,
-}
+pub use crate::fem::solid_element::SolidKind as ElementKind;
 
-/// An element: id and node indices (10 or 4).
+/// An element: id, kind and node indices (10 or 4).
 #[derive(Clone, Debug)]
 pub struct Element {
     /// Deck id.
     pub id: i64,
+    /// C3D10 or C3D4.
+    pub kind: ElementKind,
     /// Node indices (into [`Model::nodes`]), C3D10 order.
     pub nodes: Vec<usize>,
     /// Line of the element's data.
@@ -69,6 +42,21 @@ pub struct MaterialDef {
     pub density: Option<f64>,
     /// Line of `*MATERIAL`.
     pub line: usize,
+    /// File of `*MATERIAL`.
+    pub file: std::path::PathBuf,
+}
+
+/// A `*SOLID SECTION`: an element set and its material.
+#[derive(Clone, Debug)]
+pub struct Section {
+    /// Element set (upper case).
+    pub elset: String,
+    /// Material name (upper case).
+    pub material: String,
+    /// Line of the card.
+    pub line: usize,
+    /// File of the card.
+    pub file: std::path::PathBuf,
 }
 
 /// A body force: ρ g n per volume on an element.
@@ -99,6 +87,76 @@ impl Grav {
     }
 }
 
+/// A body force ρ ω² r per volume about an axis (`*DLOAD …, CENTRIF, ω², x, y, z, nx, ny, nz`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Centrif {
+    /// ω².
+    pub omega2: f64,
+    /// A point on the axis.
+    pub point: [f64; 3],
+    /// The axis direction (unit).
+    pub axis: [f64; 3],
+}
+
+/// The analysis of a step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum Analysis {
+    /// `*STATIC`: linear static.
+    #[default]
+    Static,
+    /// `*BUCKLE`: the lowest `modes` buckling factors of the step's loads.
+    Buckle {
+        /// Buckling factors wanted.
+        modes: usize,
+        /// Relative accuracy of the factors.
+        accuracy: f64,
+    },
+    /// `*FREQUENCY`: the lowest `modes` natural frequencies (at most `upper`, cycles/time).
+    Frequency {
+        /// Frequencies wanted.
+        modes: usize,
+        /// Lower bound (cycles per time; ccx's shift).
+        lower: f64,
+        /// Upper bound (cycles per time), if given.
+        upper: Option<f64>,
+    },
+}
+
+/// Local axes of a node (`*TRANSFORM`): the rotation R whose columns are the local axes in global
+/// components at a point (constant for TYPE=R, depending on the point for TYPE=C).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Transform {
+    /// Rectangular: local x along a, local y in the (a, b) plane, z = x × y.
+    Rectangular {
+        /// a.
+        a: [f64; 3],
+        /// b.
+        b: [f64; 3],
+    },
+    /// Cylindrical about the axis through a and b: local (r, θ, z).
+    Cylindrical {
+        /// a (on the axis).
+        a: [f64; 3],
+        /// b (on the axis, towards +z).
+        b: [f64; 3],
+    },
+}
+
+/// The totals of a *NODE PRINT request.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Totals {
+    /// Values per node only.
+    #[default]
+    No,
+    /// Values per node and their sum.
+    Yes,
+    /// The sum only.
+    Only,
+}
+
+/// An equation: terms (node, dof 0–2, coefficient) and the line of its first data line.
+pub type Equation = (Vec<(usize, usize, f64)>, usize);
+
 /// A step's state: supports, loads (accumulated over the earlier steps) and output requests.
 #[derive(Clone, Debug, Default)]
 pub struct Step {
@@ -114,14 +172,16 @@ pub struct Step {
     pub pressures: BTreeMap<(usize, usize), f64>,
     /// Body forces per element.
     pub gravity: BTreeMap<usize, Grav>,
-    /// `*NODE PRINT` requests: node set name → variables (U, S, RF) and TOTALS.
-    pub node_print: Vec<(String, Vec<String>, bool)>,
-    /// `*EL PRINT` requests: element set name → variables (S).
+    /// Centrifugal loads per element.
+    pub centrif: BTreeMap<usize, Centrif>,
+    /// `*NODE PRINT` requests: node set name → variables (U, S, E, RF) and TOTALS.
+    pub node_print: Vec<(String, Vec<String>, Totals)>,
+    /// `*EL PRINT` requests: element set name → variables (S, E).
     pub el_print: Vec<(String, Vec<String>)>,
-    /// Variables of `*NODE FILE`/`*EL FILE` (U, S, RF).
+    /// Variables of `*NODE FILE`/`*EL FILE` (U, S, E, RF).
     pub file_vars: Vec<String>,
-    /// `*STATIC` seen.
-    pub static_seen: bool,
+    /// The analysis (`None` before its card).
+    pub analysis: Option<Analysis>,
 }
 
 /// The model of a deck.
@@ -133,16 +193,22 @@ pub struct Model {
     pub nodes: Vec<[f64; 3]>,
     /// Elements, in file order.
     pub elements: Vec<Element>,
-    /// Element kind (`None` before any element).
-    pub kind: Option<ElementKind>,
     /// Node sets (upper-cased names) → node indices (first occurrence order, no repeats).
     pub nsets: BTreeMap<String, Vec<usize>>,
     /// Element sets → element indices.
     pub elsets: BTreeMap<String, Vec<usize>>,
     /// Materials by (upper-cased) name.
     pub materials: BTreeMap<String, MaterialDef>,
-    /// Sections: elset name, material name, line.
-    pub sections: Vec<(String, String, usize)>,
+    /// Sections.
+    pub sections: Vec<Section>,
+    /// Element-face surfaces (`*SURFACE, TYPE=ELEMENT`): name → (element, face 0–3).
+    pub element_surfaces: BTreeMap<String, Vec<(usize, usize)>>,
+    /// Local axes per node (`*TRANSFORM`).
+    pub transforms: BTreeMap<usize, Transform>,
+    /// Equations (`*EQUATION`): terms (node, dof 0–2, coefficient) and the line.
+    pub equations: Vec<Equation>,
+    /// Warnings: what is read but changes nothing, or is skipped (with its line).
+    pub warnings: Vec<String>,
     /// The steps.
     pub steps: Vec<Step>,
     pub(super) node_index: HashMap<i64, usize>,

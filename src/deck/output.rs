@@ -1,7 +1,9 @@
-//! What `rodstudy solve` writes: the JSON document (the requested node and element sets and the
-//! reaction totals per step, the last step's also at the top level) and one VTU file per step
-//! (ASCII VTK XML, quadratic tetrahedra, coordinates in the deck's units; point data: deck node id,
-//! U, RF and S — S as ParaView's symmetric tensor `[xx, yy, zz, xy, yz, xz]` — and von Mises).
+//! What `rodstudy solve` writes: the JSON document (warnings; the requested node and element sets,
+//! the reaction totals and the eigenvalues per step, the last step's also at the top level) and
+//! one VTU file per step (ASCII VTK XML, C3D10 as quadratic and C3D4 as linear tetrahedra,
+//! coordinates in the deck's units; point data: deck node id, U, RF, S and E — S and E as
+//! ParaView's symmetric tensor `[xx, yy, zz, xy, yz, xz]`, the order written into each array as
+//! its component names — von Mises, and the mode shapes of an eigen step).
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -19,14 +21,15 @@ pub fn json_document(deck: &Path, sol: &DeckSolution, extrapolation: Extrapolati
     json!({
         "deck": deck.display().to_string(),
         "nodes": sol.node_ids.len(),
-        "elements": sol.element_ids.len(),
-        "dofs": sol.mesh.n_dofs(),
-        "material": {"E": sol.material.youngs_modulus_pa, "nu": sol.material.poisson_ratio},
+        "elements": sol.elements.len(),
+        "dofs": sol.dofs,
+        "warnings": sol.warnings,
         "stress_extrapolation": match extrapolation {
             Extrapolation::Exact => "exact",
             Extrapolation::CalculiX => "calculix",
         },
-        "components": {"U": ["ux", "uy", "uz"], "S": ["sxx", "syy", "szz", "sxy", "sxz", "syz"], "RF": ["fx", "fy", "fz"]},
+        "reactions": "RF = K u, the internal force at every DOF of the node (as ccx's RF)",
+        "components": {"U": ["ux", "uy", "uz"], "S": ["sxx", "syy", "szz", "sxy", "sxz", "syz"], "E": ["exx", "eyy", "ezz", "exy", "exz", "eyz"], "RF": ["fx", "fy", "fz"]},
         "node_sets": last.node_sets,
         "element_sets": last.element_sets,
         "reaction_totals": last.reaction_totals,
@@ -35,9 +38,26 @@ pub fn json_document(deck: &Path, sol: &DeckSolution, extrapolation: Extrapolati
 }
 
 fn array(s: &mut String, name: &str, ty: &str, comps: usize, values: impl Iterator<Item = String>) {
+    named_array(s, name, ty, &[], comps, values);
+}
+
+/// A data array whose components are named (`ComponentName0`, … as VTK and ParaView read them).
+fn named_array(
+    s: &mut String,
+    name: &str,
+    ty: &str,
+    names: &[&str],
+    comps: usize,
+    values: impl Iterator<Item = String>,
+) {
+    let labels: String = names
+        .iter()
+        .enumerate()
+        .map(|(k, n)| format!(r#" ComponentName{k}="{n}""#))
+        .collect();
     let _ = writeln!(
         s,
-        r#"<DataArray type="{ty}" Name="{name}" NumberOfComponents="{comps}" format="ascii">"#
+        r#"<DataArray type="{ty}" Name="{name}" NumberOfComponents="{comps}"{labels} format="ascii">"#
     );
     let v: Vec<String> = values.collect();
     for chunk in v.chunks(6 * comps.max(1)) {
@@ -47,37 +67,18 @@ fn array(s: &mut String, name: &str, ty: &str, comps: usize, values: impl Iterat
     s.push_str("</DataArray>\n");
 }
 
-/// Writes step `k` (0-based) of `sol` to `path`.
+/// Writes step `k` (0-based) of `sol` to `path`: the nodes used by elements, the elements.
 pub fn write_step_vtu(path: &Path, sol: &DeckSolution, k: usize) -> Result<()> {
     let step = &sol.steps[k];
-    let mesh = &sol.mesh;
-    let (np, nc) = (mesh.n_nodes(), mesh.n_elements());
-    // values at mesh nodes: deck nodes' values; added (C3D4 midside) nodes from their corners are
-    // not needed by the deck's outputs and are given the mean of the deck nodes around them in
-    // the solution field, i.e. written as zero-marked (node id 0) with interpolated displacement
-    let mut u = vec![[0.0; 3]; np];
-    let mut rf = vec![[0.0; 3]; np];
-    let mut s = vec![[0.0; 6]; np];
-    for (m, d) in sol.deck_node.iter().enumerate() {
-        if let Some(d) = d {
-            u[m] = step.u[*d];
-            rf[m] = step.rf[*d];
-            s[m] = step.s[*d];
-        }
+    let used: Vec<usize> = (0..sol.node_ids.len()).filter(|&n| sol.used[n]).collect();
+    let mut point_of = vec![usize::MAX; sol.node_ids.len()];
+    for (p, &n) in used.iter().enumerate() {
+        point_of[n] = p;
     }
-    for el in mesh.elements() {
-        for (k, [a, b]) in crate::fem::shape::TET10_EDGES.iter().enumerate() {
-            let m = el[4 + k];
-            if sol.deck_node[m].is_none() {
-                let (p, q) = (el[*a], el[*b]);
-                u[m] = std::array::from_fn(|j| 0.5 * (u[p][j] + u[q][j]));
-                s[m] = std::array::from_fn(|j| 0.5 * (s[p][j] + s[q][j]));
-            }
-        }
-    }
+    let (np, nc) = (used.len(), sol.elements.len());
     let g = |v: f64| format!("{v:e}");
     let mut out = String::with_capacity(200 * np + 100 * nc);
-    out.push_str("<?xml version=\"1.0\"?>\n<!-- rodstudy solve: deck units -->\n");
+    out.push_str("<?xml version=\"1.0\"?>\n<!-- rodstudy solve: deck units; S and E components xx yy zz xy yz xz (ParaView's order) -->\n");
     out.push_str("<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n");
     let _ = writeln!(
         out,
@@ -88,40 +89,68 @@ pub fn write_step_vtu(path: &Path, sol: &DeckSolution, k: usize) -> Result<()> {
         "node_id",
         "Int64",
         1,
-        sol.deck_node
-            .iter()
-            .map(|d| d.map_or(0, |d| sol.node_ids[d]).to_string()),
+        used.iter().map(|&n| sol.node_ids[n].to_string()),
     );
     let wants = |v: &str| step.file_vars.is_empty() || step.file_vars.iter().any(|x| x == v);
+    let xyz = ["x", "y", "z"];
     if wants("U") {
-        array(
+        named_array(
             &mut out,
             "U",
             "Float64",
+            &xyz,
             3,
-            u.iter().flatten().map(|v| g(*v)),
+            used.iter().flat_map(|&n| step.u[n]).map(g),
         );
     }
     if wants("RF") {
-        array(
+        named_array(
             &mut out,
             "RF",
             "Float64",
+            &xyz,
             3,
-            rf.iter().flatten().map(|v| g(*v)),
+            used.iter().flat_map(|&n| step.rf[n]).map(g),
         );
     }
+    // CalculiX order [xx, yy, zz, xy, xz, yz] -> ParaView's [xx, yy, zz, xy, yz, xz]
+    let pv = |t: &[f64; 6]| [t[0], t[1], t[2], t[3], t[5], t[4]];
+    let tensor = ["xx", "yy", "zz", "xy", "yz", "xz"];
     if wants("S") {
-        // CalculiX order [xx, yy, zz, xy, xz, yz] -> ParaView's [xx, yy, zz, xy, yz, xz]
-        let pv = |t: &[f64; 6]| [t[0], t[1], t[2], t[3], t[5], t[4]];
-        array(&mut out, "S", "Float64", 6, s.iter().flat_map(pv).map(g));
+        named_array(
+            &mut out,
+            "S",
+            "Float64",
+            &tensor,
+            6,
+            used.iter().flat_map(|&n| pv(&step.s[n])).map(g),
+        );
         array(
             &mut out,
             "S_von_mises",
             "Float64",
             1,
-            s.iter()
-                .map(|t| g(von_mises(&[t[0], t[1], t[2], t[3], t[5], t[4]]))),
+            used.iter().map(|&n| g(von_mises(&pv(&step.s[n])))),
+        );
+    }
+    if wants("E") {
+        named_array(
+            &mut out,
+            "E",
+            "Float64",
+            &tensor,
+            6,
+            used.iter().flat_map(|&n| pv(&step.e[n])).map(g),
+        );
+    }
+    for (m, mode) in step.modes.iter().enumerate() {
+        named_array(
+            &mut out,
+            &format!("mode_{}", m + 1),
+            "Float64",
+            &xyz,
+            3,
+            used.iter().flat_map(|&n| mode[n]).map(g),
         );
     }
     out.push_str("</PointData>\n<Points>\n");
@@ -130,7 +159,7 @@ pub fn write_step_vtu(path: &Path, sol: &DeckSolution, k: usize) -> Result<()> {
         "Points",
         "Float64",
         3,
-        mesh.nodes().iter().flatten().map(|v| g(*v)),
+        used.iter().flat_map(|&n| sol.nodes[n]).map(g),
     );
     out.push_str("</Points>\n<Cells>\n");
     array(
@@ -138,21 +167,30 @@ pub fn write_step_vtu(path: &Path, sol: &DeckSolution, k: usize) -> Result<()> {
         "connectivity",
         "Int64",
         1,
-        mesh.elements().iter().flatten().map(|v| v.to_string()),
+        sol.elements
+            .iter()
+            .flat_map(|(_, nodes)| nodes.iter().map(|&n| point_of[n].to_string())),
     );
+    let mut offset = 0;
     array(
         &mut out,
         "offsets",
         "Int64",
         1,
-        (1..=nc).map(|i| (10 * i).to_string()),
+        sol.elements.iter().map(|(_, nodes)| {
+            offset += nodes.len();
+            offset.to_string()
+        }),
     );
+    // VTK_TETRA (10) for C3D4, VTK_QUADRATIC_TETRA (24) for C3D10
     array(
         &mut out,
         "types",
         "UInt8",
         1,
-        (0..nc).map(|_| "24".to_string()),
+        sol.elements
+            .iter()
+            .map(|(_, nodes)| if nodes.len() == 4 { "10" } else { "24" }.to_string()),
     );
     out.push_str("</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
     std::fs::write(path, out).map_err(|e| FemError::Io {

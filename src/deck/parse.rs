@@ -9,6 +9,12 @@
 //! are kept with one blank between the words. A UTF-8 byte-order mark before the first line is
 //! skipped; a data line of empty fields only (`,,,`) is refused with its line (outside
 //! `*HEADING`, whose lines are free text).
+//!
+//! `*INCLUDE, INPUT=FILE` reads FILE (relative to the including file's folder) in its place, as
+//! ccx does (manual, "*INCLUDE"); its cards keep their own file and line for errors. An included
+//! file starts with a keyword (its data lines cannot continue a card of the including file), and
+//! an including file's data lines after an *INCLUDE are refused likewise; includes nest at most
+//! [`MAX_INCLUDE_DEPTH`] deep.
 
 use std::path::Path;
 
@@ -32,6 +38,8 @@ pub struct Card {
     pub params: Vec<(String, String)>,
     /// 1-based line number of the keyword line.
     pub line: usize,
+    /// The file the card is written in (the deck, or a file it includes).
+    pub file: std::path::PathBuf,
     /// The data lines that follow.
     pub data: Vec<DataLine>,
 }
@@ -60,9 +68,21 @@ pub fn error(path: &Path, line: usize, message: impl Into<String>) -> FemError {
     }
 }
 
-/// Splits `text` into cards. Data lines before the first keyword are an error.
+/// How deep `*INCLUDE`s may nest (a file including itself is refused there).
+pub const MAX_INCLUDE_DEPTH: usize = 16;
+
+/// Splits `text` into cards, `*INCLUDE`s read in place. Data lines before the first keyword are
+/// an error.
 pub fn cards(path: &Path, text: &str) -> Result<Vec<Card>> {
-    let mut out: Vec<Card> = Vec::new();
+    let mut out = Vec::new();
+    cards_into(path, text, 0, &mut out)?;
+    Ok(out)
+}
+
+fn cards_into(path: &Path, text: &str, depth: usize, out: &mut Vec<Card>) -> Result<()> {
+    let start = out.len();
+    // the card that data lines continue: none right after an *INCLUDE
+    let mut open = false;
     let mut continuing = false;
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     for (i, raw) in text.lines().enumerate() {
@@ -76,6 +96,10 @@ pub fn cards(path: &Path, text: &str) -> Result<Vec<Card>> {
             continuing = t.ends_with(',');
             let card = out.last_mut().expect("continuing a card");
             card.params.extend(params(t));
+            if !continuing && card.keyword == "INCLUDE" {
+                include(path, depth, out)?;
+                open = false;
+            }
             continue;
         }
         if let Some(rest) = t.strip_prefix('*') {
@@ -95,13 +119,28 @@ pub fn cards(path: &Path, text: &str) -> Result<Vec<Card>> {
                 keyword,
                 params: params(parts.next().unwrap_or("")),
                 line: ln,
+                file: path.to_path_buf(),
                 data: Vec::new(),
             });
+            open = true;
+            if !continuing && out.last().is_some_and(|c| c.keyword == "INCLUDE") {
+                include(path, depth, out)?;
+                open = false;
+            }
             continue;
         }
-        let Some(card) = out.last_mut() else {
-            return Err(error(path, ln, "a data line before the first keyword"));
-        };
+        if !open {
+            return Err(error(
+                path,
+                ln,
+                if out.len() > start {
+                    "a data line after *INCLUDE: start the data with its keyword line again"
+                } else {
+                    "a data line before the first keyword (an included file starts with a keyword)"
+                },
+            ));
+        }
+        let card = out.last_mut().expect("an open card");
         let mut fields: Vec<String> = t.split(',').map(|f| f.trim().to_string()).collect();
         while fields.last().is_some_and(|f| f.is_empty()) {
             fields.pop();
@@ -118,7 +157,41 @@ pub fn cards(path: &Path, text: &str) -> Result<Vec<Card>> {
         }
         card.data.push(DataLine { line: ln, fields });
     }
-    Ok(out)
+    Ok(())
+}
+
+/// Replaces the `*INCLUDE` card at the end of `out` by the cards of its file.
+fn include(path: &Path, depth: usize, out: &mut Vec<Card>) -> Result<()> {
+    let card = out.pop().expect("the *INCLUDE card");
+    let Some(name) = card.param("INPUT").filter(|v| !v.is_empty()) else {
+        return Err(error(path, card.line, "*INCLUDE needs INPUT=FILE"));
+    };
+    if let Some((p, _)) = card.params.iter().find(|(p, _)| p != "INPUT") {
+        return Err(error(
+            path,
+            card.line,
+            format!("*INCLUDE: parameter {p} is not supported (INPUT=)"),
+        ));
+    }
+    if depth >= MAX_INCLUDE_DEPTH {
+        return Err(error(
+            path,
+            card.line,
+            format!(
+                "*INCLUDE nested deeper than {MAX_INCLUDE_DEPTH} files (a file including itself?)"
+            ),
+        ));
+    }
+    let name = name.trim_matches('"');
+    let file = path.parent().unwrap_or(Path::new(".")).join(name);
+    let bytes = std::fs::read(&file).map_err(|e| {
+        error(
+            path,
+            card.line,
+            format!("*INCLUDE: cannot read {}: {e}", file.display()),
+        )
+    })?;
+    cards_into(&file, &String::from_utf8_lossy(&bytes), depth + 1, out)
 }
 
 fn params(s: &str) -> Vec<(String, String)> {
