@@ -183,11 +183,7 @@ pub struct LocalAssessment {
 pub fn assess_node(settings: &LocalSettings, history: &NodeHistory) -> LocalAssessment {
     let n = unit(history.outward_normal);
     let (t1, t2) = tangent_basis(n);
-    let plane: Vec<[f64; 3]> = history
-        .stress
-        .iter()
-        .map(|s| in_plane(s, t1, t2))
-        .collect();
+    let plane: Vec<[f64; 3]> = history.stress.iter().map(|s| in_plane(s, t1, t2)).collect();
     // the longest chord of the in-plane path
     let (mut ia, mut ib, mut best) = (0, 0, -1.0);
     for i in 0..plane.len() {

@@ -139,7 +139,11 @@ pub fn findley(history: &[[f64; 6]], settings: &FindleySettings) -> FindleyResul
 
 /// Unit normal at polar angle `theta` and azimuth `phi`.
 pub fn normal_of(theta: f64, phi: f64) -> [f64; 3] {
-    [theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()]
+    [
+        theta.sin() * phi.cos(),
+        theta.sin() * phi.sin(),
+        theta.cos(),
+    ]
 }
 
 /// (τ_a, σ_n,max, τ_a + k σ_n,max) of `history` on the plane with unit normal `n`.
@@ -228,7 +232,10 @@ mod tests {
     #[test]
     fn min_circle_of_simple_sets() {
         // a segment: half its length; a square: half the diagonal; an ellipse: the semi-major axis
-        assert_eq!(min_circle_radius(&[[0.0, 0.0], [2.0, 0.0], [1.0, 0.0]]), 1.0);
+        assert_eq!(
+            min_circle_radius(&[[0.0, 0.0], [2.0, 0.0], [1.0, 0.0]]),
+            1.0
+        );
         let sq = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.5, 0.5]];
         assert!((min_circle_radius(&sq) - 0.5 * 2f64.sqrt()).abs() < 1e-12);
         let ell: Vec<[f64; 2]> = (0..360)

@@ -234,7 +234,9 @@ mod tests {
             let w = 180e6;
             let l = HaighLine { sigma_wk_pa: w, m };
             // F2: σ_m/σ_a from region I to IV
-            for ratio in [-4.0, -1.5, -1.0, -0.3, 0.0, 0.7, 1.0, 1.5, 2.9, 3.0, 5.0, 40.0] {
+            for ratio in [
+                -4.0, -1.5, -1.0, -0.3, 0.0, 0.7, 1.0, 1.5, 2.9, 3.0, 5.0, 40.0,
+            ] {
                 let sa = 50e6;
                 let sm = ratio * sa;
                 let k = l.mean_stress_factor(sa, sm, OverloadCase::ConstantRatio);

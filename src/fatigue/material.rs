@@ -96,7 +96,9 @@ impl MaterialGroup {
         // (f_W,σ, f_W,τ, a_M, b_M, a_R,σ, R_m,N,min MPa, a_G, b_G MPa)
         let (f_w_sigma, f_w_tau, a_m, b_m, a_r, r_min, a_g, b_g) = match self {
             MaterialGroup::Steel => (0.45, 0.577, 0.35, -0.1, 0.22, 400.0, 0.50, 2700.0),
-            MaterialGroup::CaseHardeningSteel => (0.40, 0.577, 0.35, -0.1, 0.22, 400.0, 0.50, 2700.0),
+            MaterialGroup::CaseHardeningSteel => {
+                (0.40, 0.577, 0.35, -0.1, 0.22, 400.0, 0.50, 2700.0)
+            }
             MaterialGroup::StainlessSteel => (0.40, 0.577, 0.35, -0.1, 0.22, 400.0, 0.40, 2400.0),
             MaterialGroup::ForgingSteel => (0.40, 0.577, 0.35, -0.1, 0.22, 400.0, 0.50, 2700.0),
             MaterialGroup::CastSteel => (0.34, 0.577, 0.35, 0.05, 0.20, 400.0, 0.25, 2000.0),
@@ -223,8 +225,10 @@ mod tests {
             assert!(c.f_w_tau >= 0.577 && c.f_w_tau < 1.0, "{g:?}");
             assert!(c.r_m_n_min_pa > 0.0 && c.b_g_pa > 0.0, "{g:?}");
         }
-        assert!(FatigueMaterial::fkm(MaterialGroup::Steel, 400e6, 500e6)
-            .validate()
-            .is_err());
+        assert!(
+            FatigueMaterial::fkm(MaterialGroup::Steel, 400e6, 500e6)
+                .validate()
+                .is_err()
+        );
     }
 }
