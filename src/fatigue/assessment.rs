@@ -303,11 +303,13 @@ mod tests {
 
     #[test]
     fn fully_reversed_uniaxial_at_the_component_limit_has_utilisation_one() {
-        let mut settings = LocalSettings::default();
-        settings.safety = SafetyFactors {
-            load: 1.0,
-            material: 1.0,
-            casting: 1.0,
+        let settings = LocalSettings {
+            safety: SafetyFactors {
+                load: 1.0,
+                material: 1.0,
+                casting: 1.0,
+            },
+            ..LocalSettings::default()
         };
         let strength = local_strength(&settings.material, &settings.surface, 0.0, 0.0);
         // 36 steps: sin reaches ±1 at steps 9 and 27

@@ -58,7 +58,8 @@ pub const FORGED_SKIN_RZ_M: f64 = 200e-6;
 /// The support factor n(χ*) of a related stress gradient `chi_star_per_m` (1/m) for tensile
 /// strength `r_m_pa` and group constants `a_g`, `b_g_pa` (see the module documentation).
 pub fn support_factor(chi_star_per_m: f64, r_m_pa: f64, a_g: f64, b_g_pa: f64) -> f64 {
-    if !(chi_star_per_m > 0.0) {
+    // χ* ≤ 0 or NaN: no support
+    if chi_star_per_m.is_nan() || chi_star_per_m <= 0.0 {
         return 1.0;
     }
     let chi_mm = (chi_star_per_m.min(CHI_STAR_MAX_PER_M)) * 1e-3;

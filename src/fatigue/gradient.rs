@@ -355,7 +355,8 @@ mod tests {
             .collect();
         let a: f64 = w0.iter().zip(&v).map(|(w, v)| w * v).sum();
         let b: f64 = w1.iter().zip(&v).map(|(w, v)| w * v).sum();
-        assert!((a - 3.0).abs() < 1e-12 && (b + 5.0).abs() < 1e-9, "{a} {b}");
+        // b carries the round-off of 3 over a lever of 6 mm: 1e-6 relative
+        assert!((a - 3.0).abs() < 1e-12 && (b + 5.0).abs() < 5e-6, "{a} {b}");
     }
 
     #[test]
