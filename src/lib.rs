@@ -17,6 +17,7 @@
 //! - [`fem`]: the mathematics of stage 3 and the cycle: linear elasticity with 10-node tetrahedra
 //!   (faer Cholesky), von Mises under F_x and F_y, recovery, error estimates, the adaptive loop,
 //!   inertia-relief unit cases; it returns fields and opens no file;
+//! - [`fatigue`]: FKM local fatigue strength and the Findley critical plane per surface node;
 //! - [`stages`]: the spine of a design study, one function per stage from a loaded design and
 //!   settings to a typed record (mass, dynamics, fem, cycle), writing nothing;
 //! - [`study`]: running the stages over every design of a folder (cache, shards, merge, baseline);
@@ -35,6 +36,7 @@ pub mod bench;
 pub mod cli;
 pub mod config;
 pub mod deck;
+pub mod fatigue;
 pub mod fem;
 pub mod free_run;
 pub mod geometry;
