@@ -28,6 +28,7 @@ pub mod body_force;
 pub mod bores;
 pub mod boundary;
 pub mod buckling;
+pub mod contact;
 pub mod cycle;
 pub mod element;
 pub mod error;
