@@ -174,3 +174,172 @@ fn a_pressed_pin_in_a_thick_ring_gives_lames_pressure_and_hoop_stress() {
     assert!((d.along_m / (2.0 * delta) - 1.0).abs() < 1e-6, "{d:?}");
     assert!((d.across_m / (2.0 * delta) - 1.0).abs() < 1e-6, "{d:?}");
 }
+
+/// The rigid pin with clearance in an infinite plate (plane strain), by a Fourier series method
+/// independent of the finite elements: for contact over |θ| < α, returns (Δμ/P, p(0) a/P) —
+/// the clearance Δ for which the contact reaches α under the load P per unit thickness, and the
+/// peak pressure.
+///
+/// The radial displacement of the hole r = a under a normal pressure p(θ) = p₀ + Σ p_n cos nθ
+/// (Michell's solution; J. R. Barber, *Elasticity*, ch. 9, derived for this test): u_r = p₀ a/(2μ)
+/// for n = 0 (here with the outer edge r = b held, u_r = a²(1/a − a/b²) p₀ / (2(λ+μ) a²/b² + 2μ)),
+/// u_r = p_n a/(4μ) (κ/(n − 1) + 1/(n + 1)) cos nθ for n ≥ 2 (κ = 3 − 4ν); n = 1 is a rigid
+/// translation, absorbed with the pin's own. The pressure is piecewise linear on N intervals of
+/// [0, α] and vanishes at α; the gap Δ + u_r(θ) − w cos θ vanishes at the N + 1 nodes and
+/// π a p₁ = P: N + 2 linear equations for the N nodal pressures, the pin's translation w and Δ
+/// (the approach of A. Noble, M. A. Hussain, *Exact solution of certain dual series for
+/// indentation and inclusion problems*, IJES 7 (1969), and of M. Ciavarella, P. Decuzzi,
+/// IJSS 38 (2001) 4525–4533, part II, for a pin of another material).
+fn pin_in_plate(alpha: f64, nu: f64, b_over_a: f64, n: usize, n_max: usize) -> (f64, f64) {
+    let kappa = 3.0 - 4.0 * nu;
+    let lam = 2.0 * nu / (1.0 - 2.0 * nu); // μ = 1, a = 1
+    let b2 = b_over_a * b_over_a;
+    let u0 = (1.0 - 1.0 / b2) / (2.0 * (lam + 1.0) / b2 + 2.0);
+    let h = alpha / n as f64;
+    let theta: Vec<f64> = (0..=n).map(|i| i as f64 * h).collect();
+    let m = |i: usize| if i == 0 { 1.0 } else { 2.0 };
+    let kn = |k: usize| {
+        let kf = k as f64;
+        2.0 * (1.0 - (kf * h).cos()) / (kf * kf * h)
+    };
+    let dim = n + 2;
+    let mut mat = nalgebra::DMatrix::<f64>::zeros(dim, dim);
+    let mut rhs = nalgebra::DVector::<f64>::zeros(dim);
+    let cn: Vec<f64> = (0..=n_max)
+        .map(|k| {
+            if k < 2 {
+                0.0
+            } else {
+                let kf = k as f64;
+                0.25 * (kappa / (kf - 1.0) + 1.0 / (kf + 1.0)) * kn(k) / std::f64::consts::PI
+            }
+        })
+        .collect();
+    // cos(kθ_i) for every node and harmonic
+    let cos: Vec<Vec<f64>> = theta
+        .iter()
+        .map(|t| (0..=n_max).map(|k| (k as f64 * t).cos()).collect())
+        .collect();
+    for (row, tk) in theta.iter().enumerate() {
+        for i in 0..n {
+            let series: f64 = (2..=n_max).map(|k| cn[k] * cos[i][k] * cos[row][k]).sum();
+            mat[(row, i)] = u0 * m(i) * h / (2.0 * std::f64::consts::PI) + m(i) * series;
+        }
+        mat[(row, n)] = -tk.cos();
+        mat[(row, n + 1)] = 1.0;
+    }
+    for i in 0..n {
+        mat[(n + 1, i)] = m(i) * kn(1) * theta[i].cos();
+    }
+    rhs[n + 1] = 1.0;
+    let x = mat.lu().solve(&rhs).expect("regular");
+    (x[n + 1], x[0])
+}
+
+#[test]
+fn a_pin_with_clearance_in_a_large_plate_matches_the_fourier_series_solution() {
+    // plane strain (u_z = 0 everywhere), a = 10 mm, outer edge b = 25 a held, clearance 10 µm
+    let (a, b, clearance, t) = (0.010, 0.25, 10e-6, 0.0005);
+    let mesh = ring_tet10(&Ring {
+        inner_radius: a,
+        outer_radius: b,
+        thickness: t,
+        n_theta: 96,
+        n_radial: 14,
+        n_z: 1,
+        grading: 60.0,
+    })
+    .unwrap();
+    let faces = wall_faces(&mesh, 0.0, a);
+    let mut prescribed = Vec::new();
+    for (i, x) in mesh.nodes().iter().enumerate() {
+        prescribed.push((3 * i + 2, 0.0));
+        if (x[0].hypot(x[1]) - b).abs() < 1e-9 {
+            prescribed.push((3 * i, 0.0));
+            prescribed.push((3 * i + 1, 0.0));
+        }
+    }
+    let mu = E / (2.0 * (1.0 + NU));
+    for alpha_deg in [40.0f64, 65.0] {
+        let (d_hat, p_hat) = pin_in_plate(alpha_deg.to_radians(), NU, b / a, 160, 4000);
+        // the reference's own discretisation error: the same with half the intervals
+        let (d_half, p_half) = pin_in_plate(alpha_deg.to_radians(), NU, b / a, 80, 4000);
+        let load_per_m = clearance * mu / d_hat;
+        let mut p = problem(
+            &mesh,
+            vec![pin(
+                faces.clone(),
+                a - clearance,
+                PinMotion::Force([load_per_m * t, 0.0, 0.0]),
+            )],
+        );
+        p.prescribed = prescribed.clone();
+        let s = solve_contact(&p).unwrap();
+        recheck(&p, &s);
+        let c = &s.cylinders[0];
+        let half = 0.5 * c.arc_deg;
+        let peak_ref = p_hat * load_per_m / a;
+        eprintln!(
+            "α {alpha_deg}°: FE arc ±{half:.2}° ({:?}), peak {:.4e} (nodal {:.4e}) vs {peak_ref:.4e} \
+             ({:+.2} %); reference Δμ/P {d_hat:.5} (N/2: {:+.1e}), p a/P {p_hat:.4} (N/2: {:+.1e}); \
+             {} iterations, {} columns, penetration {:.2e} of the gap scale, {:?}",
+            c.arc_ends_deg,
+            c.peak_pressure_pa,
+            c.peak_nodal_pressure_pa,
+            100.0 * (c.peak_pressure_pa / peak_ref - 1.0),
+            d_half / d_hat - 1.0,
+            p_half / p_hat - 1.0,
+            s.iterations,
+            s.columns,
+            s.check.penetration_rel,
+            s.timings
+        );
+        // the edge lies between the last active node and the next: one node spacing
+        let spacing = 360.0 / 192.0;
+        assert!((half - alpha_deg).abs() <= spacing, "{half} vs {alpha_deg}");
+        // the reference is converged to < 0.1 % in the peak (N against N/2)
+        assert!((c.peak_pressure_pa / peak_ref - 1.0).abs() < 0.01);
+        assert!(s.check.penetration_rel < 1e-3);
+    }
+    // zero clearance: the contact arc does not depend on the load (the problem is linear and
+    // homogeneous in P); the reference's arc is where its clearance vanishes (bisection)
+    let (mut lo, mut hi) = (60f64.to_radians(), 89.5f64.to_radians());
+    for _ in 0..14 {
+        let mid = 0.5 * (lo + hi);
+        if pin_in_plate(mid, NU, b / a, 160, 4000).0 > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let alpha0 = 0.5 * (lo + hi);
+    let p_hat0 = pin_in_plate(alpha0, NU, b / a, 160, 4000).1;
+    let load_per_m = 1e5;
+    let mut p = problem(
+        &mesh,
+        vec![pin(
+            faces.clone(),
+            a,
+            PinMotion::Force([0.0, -load_per_m * t, 0.0]),
+        )],
+    );
+    p.prescribed = prescribed;
+    let s = solve_contact(&p).unwrap();
+    recheck(&p, &s);
+    let c = &s.cylinders[0];
+    let peak_ref = p_hat0 * load_per_m / a;
+    // the cosine distribution over ±90° of the same resultant: p₀ = 2P/(π a)
+    let cosine = 2.0 * load_per_m / (std::f64::consts::PI * a);
+    eprintln!(
+        "zero clearance: reference α₀ {:.2}°, FE arc ±{:.2}°, peak {:.4e} vs {peak_ref:.4e} ({:+.2} %),          cosine's {cosine:.4e} ({:+.1} %)",
+        alpha0.to_degrees(),
+        0.5 * c.arc_deg,
+        c.peak_pressure_pa,
+        100.0 * (c.peak_pressure_pa / peak_ref - 1.0),
+        100.0 * (c.peak_pressure_pa / cosine - 1.0)
+    );
+    assert!((0.5 * c.arc_deg - alpha0.to_degrees()).abs() <= 360.0 / 192.0);
+    assert!((c.peak_pressure_pa / peak_ref - 1.0).abs() < 0.01);
+    // the resultant points along the force, the peak at its direction
+    assert!(c.peak_angle_deg.abs() < 2.0, "{}", c.peak_angle_deg);
+}
