@@ -9,6 +9,7 @@ use rodstudy::fem::contact::{
     diameter_change, solve_contact,
 };
 use rodstudy::fem::mesh::ring::{Ring, ring_tet10};
+use rodstudy::fem::mesh::structured::{TwoEyePlate, two_eye_plate};
 use rodstudy::fem::stress::stress_field;
 use rodstudy::fem::{Material, QuadratureChoice, TetMesh};
 
@@ -28,6 +29,10 @@ fn wall_faces(mesh: &TetMesh, cx: f64, r: f64) -> Vec<[usize; 6]> {
             })
         })
         .collect()
+}
+
+fn norm3(v: [f64; 3]) -> f64 {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
 }
 
 fn pin(faces: Vec<[usize; 6]>, radius: f64, motion: PinMotion) -> Cylinder {
@@ -62,7 +67,9 @@ fn recheck(p: &ContactProblem, s: &ContactSolution) {
     let pins: Vec<[f64; 3]> = s.cylinders.iter().map(|c| c.pin_displacement_m).collect();
     let (c, r) = check(p, &s.displacements, &pressures, &pins, &s.restraint.dofs).unwrap();
     c.verify(&p.tolerances).unwrap();
-    assert_eq!(r, s.restraint);
+    assert_eq!(r.dofs, s.restraint.dofs);
+    assert_eq!(r.force_n, s.restraint.force_n);
+    assert_eq!(r.moment_nm, s.restraint.moment_nm);
     for cyl in &s.cylinders {
         assert!(cyl.max_tensile_pressure_pa <= 0.0);
     }
@@ -342,4 +349,105 @@ fn a_pin_with_clearance_in_a_large_plate_matches_the_fourier_series_solution() {
     assert!((c.peak_pressure_pa / peak_ref - 1.0).abs() < 0.01);
     // the resultant points along the force, the peak at its direction
     assert!(c.peak_angle_deg.abs() < 2.0, "{}", c.peak_angle_deg);
+}
+
+/// The plate with two bores of `two_eye_plate` (curved bore walls), its bore walls.
+fn two_eye() -> (TetMesh, Vec<[usize; 6]>, Vec<[usize; 6]>, TwoEyePlate) {
+    let plate = TwoEyePlate {
+        curved: true,
+        n_side: 6,
+        ..TwoEyePlate::default()
+    };
+    let mesh = two_eye_plate(&plate).unwrap();
+    let fa = wall_faces(&mesh, 0.0, plate.bore_a_radius);
+    let fb = wall_faces(&mesh, plate.length, plate.bore_b_radius);
+    (mesh, fa, fb, plate)
+}
+
+#[test]
+fn a_body_held_by_two_pins_carries_the_pin_force_and_its_free_motions_carry_nothing() {
+    // pin A (clearance 20 µm) pushes along AB towards B; pin B (clearance 10 µm) holds the body
+    let (mesh, fa, fb, plate) = two_eye();
+    let force = [20e3, 0.0, 0.0];
+    let pa = pin(fa, plate.bore_a_radius - 20e-6, PinMotion::Force(force));
+    let mut pb = pin(fb, plate.bore_b_radius - 10e-6, PinMotion::Fixed);
+    pb.axis_point_m = [plate.length, 0.0, 0.0];
+    let p = problem(&mesh, vec![pa, pb]);
+    let s = solve_contact(&p).unwrap();
+    recheck(&p, &s);
+    let (a, b) = (&s.cylinders[0], &s.cylinders[1]);
+    eprintln!(
+        "two pins: A arc {:.1}° peak {:.3e} Pa, B arc {:.1}° peak {:.3e} Pa; restraint {:?}; \
+         {} iterations, {} of {} columns; {:?}",
+        a.arc_deg,
+        a.peak_pressure_pa,
+        b.arc_deg,
+        b.peak_pressure_pa,
+        s.restraint,
+        s.iterations,
+        s.columns,
+        s.rows,
+        s.timings
+    );
+    // the contact forces on the body: F at A (to 1e-10, the solver's own check) and −F at B
+    // (equilibrium of the body; nothing else holds it but the free motions' support)
+    for j in 0..3 {
+        assert!((a.resultant_n[j] - force[j]).abs() <= 1e-10 * 20e3);
+        assert!((b.resultant_n[j] + force[j]).abs() <= 1e-8 * 20e3);
+    }
+    // the rotation about B and the sliding along the axis are held by a support that carries
+    // nothing: the force balances along AB
+    assert_eq!(s.restraint.free_motions, 2);
+    assert!(s.restraint.reaction_rel < 1e-8, "{:?}", s.restraint);
+    // A presses towards +x (its arc centred on the force), B is pressed on its −x side
+    assert!(a.arc_deg > 0.0 && a.arc_deg < 180.0 && a.peak_angle_deg.abs() < 10.0);
+    assert!(b.arc_deg > 0.0 && b.arc_deg < 180.0);
+    // the loaded bore ovalises as a pin-loaded lug's hole does: longer along the force,
+    // narrower across it
+    let d = diameter_change(&mesh, &p.cylinders[0], &s.displacements, force).unwrap();
+    eprintln!(
+        "bore A diameter change along {:.3e} m, across {:.3e} m",
+        d.along_m, d.across_m
+    );
+    assert!(d.along_m > 0.0 && d.across_m < 0.0, "{d:?}");
+
+    // a transverse force at A is not in balance about B: refused, unless the caller accepts
+    // the support's reaction, which is then the moment F·L about B's axis
+    let mut q = p.clone();
+    q.cylinders[0].motion = PinMotion::Force([0.0, 5e3, 0.0]);
+    let err = solve_contact(&q).unwrap_err().to_string();
+    assert!(err.contains("not in balance"), "{err}");
+    q.tolerances.free_mode_reaction_rel = None;
+    let s = solve_contact(&q).unwrap();
+    // the support's reaction is a pure couple about B's axis, −(A − B) × F = 5e3 L ẑ (statics
+    // of the body: pin B's radial contact forces have no moment about its axis); pin A still
+    // carries its whole force
+    let r = &s.restraint;
+    eprintln!("transverse: restraint {r:?}");
+    assert!(norm3(r.force_n) < 1e-8 * 5e3, "{r:?}");
+    assert!(
+        (r.moment_nm[2] - 5e3 * plate.length).abs() < 1e-8 * 5e3 * plate.length,
+        "{r:?}"
+    );
+    assert!((s.cylinders[0].resultant_n[1] - 5e3).abs() < 1e-10 * 5e3);
+}
+
+#[test]
+fn a_pin_pressing_on_a_missing_wall_is_refused() {
+    // pin A's wall is the half x < 0 only; a force along +x has nothing to press on
+    let (mesh, fa, fb, plate) = two_eye();
+    let half: Vec<[usize; 6]> = fa
+        .into_iter()
+        .filter(|f| f[..3].iter().all(|&n| mesh.nodes()[n][0] < 1e-9))
+        .collect();
+    let pa = pin(
+        half,
+        plate.bore_a_radius - 20e-6,
+        PinMotion::Force([1e3, 0.0, 0.0]),
+    );
+    let mut pb = pin(fb, plate.bore_b_radius - 10e-6, PinMotion::Fixed);
+    pb.axis_point_m = [plate.length, 0.0, 0.0];
+    let err = solve_contact(&problem(&mesh, vec![pa, pb])).unwrap_err();
+    eprintln!("{err}");
+    assert!(matches!(err, rodstudy::fem::FemError::Solver(_)), "{err}");
 }

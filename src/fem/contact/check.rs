@@ -228,6 +228,7 @@ pub fn check(
         out,
         Restraint {
             dofs: support.to_vec(),
+            free_motions: 0,
             force_n: force,
             moment_nm: moment,
             point_m: point,

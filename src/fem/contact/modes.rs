@@ -19,7 +19,8 @@ use crate::fem::mesh::TetMesh;
 /// The floating rigid motions of a body and the support that removes them.
 #[derive(Clone, Debug)]
 pub struct Floating {
-    /// Reference point of the rotations, m (the bounding-box centre).
+    /// Reference point of the rotations, m (a fixed pin's axis point, else the bounding-box
+    /// centre).
     pub centre: [f64; 3],
     /// Length that scales the rotations (the bounding-box diagonal), m.
     pub length: f64,
@@ -75,10 +76,16 @@ impl Floating {
 }
 
 /// The floating motions of `mesh` under the prescribed DOFs `prescribed`, and a support for
-/// them on DOFs outside `avoid` (the contact walls' DOFs) and `prescribed`.
-pub fn floating(mesh: &TetMesh, prescribed: &[usize], avoid: &[bool]) -> Result<Floating> {
+/// them on DOFs outside `avoid` (the contact walls' DOFs) and `prescribed`. Rotations are taken
+/// about `centre` (the bounding-box centre when `None`).
+pub fn floating(
+    mesh: &TetMesh,
+    prescribed: &[usize],
+    avoid: &[bool],
+    centre: Option<[f64; 3]>,
+) -> Result<Floating> {
     let (lo, hi) = mesh.bounding_box();
-    let centre = std::array::from_fn(|j| 0.5 * (lo[j] + hi[j]));
+    let centre = centre.unwrap_or(std::array::from_fn(|j| 0.5 * (lo[j] + hi[j])));
     let length = ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2))
         .sqrt()
         .max(f64::MIN_POSITIVE);

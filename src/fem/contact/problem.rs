@@ -98,6 +98,9 @@ pub struct Restraint {
     /// The DOFs of the support (one per motion held; none when the prescribed DOFs hold the
     /// body).
     pub dofs: Vec<usize>,
+    /// The motions that no pin holds (held by this support alone): the rotation about a lone
+    /// fixed pin with the force-driven pins following it, the sliding along the pins.
+    pub free_motions: usize,
     /// Force, N.
     pub force_n: [f64; 3],
     /// Moment about `point_m`, N·m.

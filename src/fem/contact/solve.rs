@@ -15,9 +15,12 @@
 //! with S = C K_S⁻¹ Cᵀ, h = D g₀ + C K_S⁻¹ f, y = (α, w), Z = [CΦ, −B], q = (−Φᵀf, −F).
 //! The combinations y with Z y = 0 move nothing against a pin (the rotation about a lone fixed
 //! pin with the force-driven pins following it, the sliding along the pins): their equations
-//! cannot be met by contact, so they are held (y restricted to the row space of Z, through the
-//! eigenvectors of ZᵀZ) and the support S carries their out-of-balance, reported as the
-//! [`super::problem::Restraint`].
+//! cannot be met by contact. Their body part α_f is held (y restricted to the complement of the
+//! α_f, the pins' translations left free so that each pin still carries its whole force) and
+//! the support S carries the out-of-balance, reported as the [`super::problem::Restraint`].
+//! With the rotations taken about the fixed pin's axis, the held rotation about that pin is a
+//! pure rotation, and the support's reaction a pure couple about the pin's axis (plus a force
+//! along it for the sliding).
 //!
 //! Cost: one assembly and one Cholesky factorisation, one solve per column of S that the
 //! active-set iteration needs (the rows ever active, blocked 32 at a time), dense Cholesky of
@@ -74,7 +77,14 @@ pub fn solve_contact(problem: &ContactProblem) -> Result<ContactSolution> {
             "contact: prescribed DOF {d} out of range"
         )));
     }
-    let fl = floating(mesh, &user, &on_wall)?;
+    // rotations about the first fixed pin's axis: a motion free about it is then a pure
+    // rotation, and its held direction a pure couple (no force on the support)
+    let pivot = problem
+        .cylinders
+        .iter()
+        .find(|c| c.motion == PinMotion::Fixed)
+        .map(|c| c.axis_point_m);
+    let fl = floating(mesh, &user, &on_wall, pivot)?;
     let k = fl.k();
     let mut prescribed = problem.prescribed.clone();
     prescribed.extend(fl.support.iter().map(|&d| (d, 0.0)));
@@ -159,16 +169,17 @@ pub fn solve_contact(problem: &ContactProblem) -> Result<ContactSolution> {
         q[k + 2 * p] = -dot(fv, walls[w].basis.0);
         q[k + 2 * p + 1] = -dot(fv, walls[w].basis.1);
     }
-    // the row space of Z: the held combinations are its null space
+    // the null space of Z: combinations (α, w) that move nothing against a pin. Their body
+    // part α is held (the pins' translations stay free, so each pin still carries its whole
+    // force): y is restricted to the complement of the held α-directions
     let zt_z = nalgebra::DMatrix::from_fn(nz, nz, |r, c| {
         z.iter().map(|row| row[r] * row[c]).sum::<f64>()
     });
     let eig = zt_z.symmetric_eigen();
     let top = eig.eigenvalues.iter().copied().fold(0.0, f64::max);
-    let range: Vec<usize> = (0..nz)
-        .filter(|&i| eig.eigenvalues[i] > 1e-10 * top)
-        .collect();
-    for i in (0..nz).filter(|i| !range.contains(i)) {
+    let mut held = nalgebra::DMatrix::<f64>::zeros(nz, nz);
+    let mut free_motions = 0;
+    for i in (0..nz).filter(|&i| eig.eigenvalues[i] <= 1e-10 * top) {
         let alpha_part: f64 = (0..k).map(|r| eig.eigenvectors[(r, i)].powi(2)).sum();
         if alpha_part < 1e-6 {
             return Err(FemError::Solver(
@@ -177,19 +188,30 @@ pub fn solve_contact(problem: &ContactProblem) -> Result<ContactSolution> {
                     .into(),
             ));
         }
+        let h = nalgebra::DVector::from_fn(
+            nz,
+            |r, _| {
+                if r < k { eig.eigenvectors[(r, i)] } else { 0.0 }
+            },
+        );
+        held += &h * h.transpose() / alpha_part;
+        free_motions += 1;
     }
+    let proj = held.symmetric_eigen();
+    let basis = proj.eigenvectors;
+    let range: Vec<usize> = (0..nz).filter(|&i| proj.eigenvalues[i] < 0.5).collect();
     let e: Vec<Vec<f64>> = z
         .iter()
         .map(|row| {
             range
                 .iter()
-                .map(|&i| (0..nz).map(|r| row[r] * eig.eigenvectors[(r, i)]).sum())
+                .map(|&i| (0..nz).map(|r| row[r] * basis[(r, i)]).sum())
                 .collect()
         })
         .collect();
     let qe: Vec<f64> = range
         .iter()
-        .map(|&i| (0..nz).map(|r| q[r] * eig.eigenvectors[(r, i)]).sum())
+        .map(|&i| (0..nz).map(|r| q[r] * basis[(r, i)]).sum())
         .collect();
 
     // the first active set: rows closed or penetrating at the start, and rows facing each
@@ -285,14 +307,14 @@ pub fn solve_contact(problem: &ContactProblem) -> Result<ContactSolution> {
     timings.columns_s = columns_s;
     timings.active_set_s = t.elapsed().as_secs_f64() - columns_s;
 
-    // y = Q_r η = (α, w)
+    // y = Q η = (α, w)
     let t = Instant::now();
     let y: Vec<f64> = (0..nz)
         .map(|r| {
             range
                 .iter()
                 .zip(&sol.eta)
-                .map(|(&i, eta)| eig.eigenvectors[(r, i)] * eta)
+                .map(|(&i, eta)| basis[(r, i)] * eta)
                 .sum()
         })
         .collect();
@@ -317,7 +339,8 @@ pub fn solve_contact(problem: &ContactProblem) -> Result<ContactSolution> {
             None => [0.0; 3],
         })
         .collect();
-    let (chk, restraint) = check(problem, &u, &pressures, &pins, &fl.support)?;
+    let (chk, mut restraint) = check(problem, &u, &pressures, &pins, &fl.support)?;
+    restraint.free_motions = free_motions;
     let cylinders = walls
         .iter()
         .zip(&pressures)
