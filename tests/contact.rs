@@ -391,9 +391,9 @@ fn a_body_held_by_two_pins_carries_the_pin_force_and_its_free_motions_carry_noth
     );
     // the contact forces on the body: F at A (to 1e-10, the solver's own check) and −F at B
     // (equilibrium of the body; nothing else holds it but the free motions' support)
-    for j in 0..3 {
-        assert!((a.resultant_n[j] - force[j]).abs() <= 1e-10 * 20e3);
-        assert!((b.resultant_n[j] + force[j]).abs() <= 1e-8 * 20e3);
+    for (j, fj) in force.iter().enumerate() {
+        assert!((a.resultant_n[j] - fj).abs() <= 1e-10 * 20e3);
+        assert!((b.resultant_n[j] + fj).abs() <= 1e-8 * 20e3);
     }
     // the rotation about B and the sliding along the axis are held by a support that carries
     // nothing: the force balances along AB
@@ -450,4 +450,13 @@ fn a_pin_pressing_on_a_missing_wall_is_refused() {
     let err = solve_contact(&problem(&mesh, vec![pa, pb])).unwrap_err();
     eprintln!("{err}");
     assert!(matches!(err, rodstudy::fem::FemError::Solver(_)), "{err}");
+}
+
+#[test]
+#[ignore = "a benchmark: cargo test --release --test contact -- --ignored --nocapture"]
+fn contact_against_linear_cost() {
+    for n in [6, 10] {
+        let b = rodstudy::bench::contact::bench_contact(n, 3).unwrap();
+        eprintln!("{b:?}");
+    }
 }

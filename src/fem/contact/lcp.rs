@@ -65,11 +65,11 @@ pub struct LcpSolution {
     pub columns: usize,
 }
 
+/// The callback that returns the columns S[:, j] of the rows `js`.
+pub type Columns<'a> = dyn FnMut(&[usize]) -> Result<Vec<Vec<f64>>> + 'a;
+
 /// Solves `p`; `columns(js)` returns the columns S[:, j] (each of length m) of the rows `js`.
-pub fn solve(
-    p: &MixedLcp,
-    columns: &mut dyn FnMut(&[usize]) -> Result<Vec<Vec<f64>>>,
-) -> Result<LcpSolution> {
+pub fn solve(p: &MixedLcp, columns: &mut Columns<'_>) -> Result<LcpSolution> {
     let m = p.h.len();
     let mut cache: Vec<Option<Vec<f64>>> = vec![None; m];
     let mut n_cols = 0;
@@ -174,7 +174,7 @@ fn solve_active(
     let h = e_a.transpose() * &x;
     let eig = h.clone().symmetric_eigen();
     let (lo, hi) = (eig.eigenvalues.min(), eig.eigenvalues.max());
-    if !(lo > 1e-12 * hi) {
+    if lo.partial_cmp(&(1e-12 * hi)) != Some(std::cmp::Ordering::Greater) {
         return Err(FemError::Solver(format!(
             "contact: near-singular — the {na} active contact rows cannot carry the pin forces \
              or hold the body's rigid motion (Schur complement eigenvalues {lo:.3e} … {hi:.3e}); \

@@ -116,7 +116,7 @@ pub fn diameter_change(
     let a = cylinder.unit_axis(0)?;
     let dp: [f64; 3] = std::array::from_fn(|j| direction[j] - dot(direction, a) * a[j]);
     let l = norm(dp);
-    if !(l > 1e-12 * norm(direction).max(1e-300)) {
+    if l.partial_cmp(&(1e-12 * norm(direction).max(1e-300))) != Some(std::cmp::Ordering::Greater) {
         return Err(FemError::InvalidInput(
             "diameter change: the direction is along the axis".into(),
         ));

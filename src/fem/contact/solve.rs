@@ -287,9 +287,9 @@ pub fn solve_contact(problem: &ContactProblem) -> Result<ContactSolution> {
                 let (w, b) = rows[j];
                 let wall = &walls[w];
                 for &(a, d) in &wall.weights[b] {
-                    for jj in 0..3 {
-                        if let Some(qd) = eqs[w][a][jj] {
-                            rhs[c * n_eq + qd] += d * wall.e[a][jj];
+                    for (eq, ej) in eqs[w][a].iter().zip(wall.e[a]) {
+                        if let Some(qd) = eq {
+                            rhs[c * n_eq + qd] += d * ej;
                         }
                     }
                 }

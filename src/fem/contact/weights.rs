@@ -96,7 +96,7 @@ impl Wall {
         let mut g0 = Vec::with_capacity(nodes.len());
         for &n in &nodes {
             let (r0, er) = radial(mesh.nodes()[n], cyl.axis_point_m, axis);
-            if !(r0 > 1e-9 * cyl.radius_m) {
+            if r0.partial_cmp(&(1e-9 * cyl.radius_m)) != Some(std::cmp::Ordering::Greater) {
                 return Err(FemError::InvalidInput(format!(
                     "contact cylinder {index}: wall node {n} lies on the axis"
                 )));
@@ -164,8 +164,8 @@ impl Wall {
     pub fn force_per_pressure(&self, b: usize) -> [f64; 3] {
         let mut c = [0.0; 3];
         for &(a, d) in &self.weights[b] {
-            for j in 0..3 {
-                c[j] += d * self.e[a][j];
+            for (cj, ej) in c.iter_mut().zip(self.e[a]) {
+                *cj += d * ej;
             }
         }
         c
@@ -273,14 +273,14 @@ mod tests {
         ];
         let d = face_weights(&x);
         let area = 0.5;
-        for b in 0..6 {
-            let row: f64 = d[b].iter().sum();
+        for (b, drow) in d.iter().enumerate() {
+            let row: f64 = drow.iter().sum();
             // ∫ψ_b = A/12 at a corner, A/4 at a midside node (hat functions on A/4 triangles)
             let expect = if b < 3 { area / 12.0 } else { area / 4.0 };
             assert!((row - expect).abs() < 1e-15, "{b}: {row}");
         }
         for a in 0..6 {
-            let col: f64 = (0..6).map(|b| d[b][a]).sum();
+            let col: f64 = d.iter().map(|r| r[a]).sum();
             // Σ_b ψ_b = 1: ∫ N_a = 0 at a corner, A/3 at a midside node (Zienkiewicz & Taylor)
             let expect = if a < 3 { 0.0 } else { area / 3.0 };
             assert!((col - expect).abs() < 1e-15, "{a}: {col}");
