@@ -1,6 +1,7 @@
 //! Benchmarks: each stage timed against a reference run in the same process, so the figures
 //! are ratios that travel between machines better than seconds.
 
+pub mod contact;
 pub mod fem_adaptive;
 pub mod fem_convergence;
 pub mod fem_mesh;

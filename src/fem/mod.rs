@@ -27,6 +27,7 @@ pub mod body_force;
 pub mod boundary;
 pub mod buckling;
 pub mod constraints;
+pub mod contact;
 pub mod element;
 pub mod error;
 pub mod estimate;

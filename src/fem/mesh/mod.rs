@@ -5,6 +5,7 @@
 
 pub mod mirror;
 pub mod pieces;
+pub mod ring;
 pub mod structured;
 
 use super::element::{ElementCoords, QuadratureChoice, check_jacobian, is_straight};

@@ -1,0 +1,125 @@
+//! Cost of a contact solve against the linear solve of the same mesh: the two-bore plate
+//! ([`crate::fem::mesh::structured::two_eye_plate`], curved bore walls), pin A pushing along AB
+//! with a 20 µm clearance, pin B (10 µm) holding the body, against the linear solve with the
+//! same force as a uniform traction on bore A and bore B fixed (the thesis' load model).
+
+use std::time::Duration;
+
+use super::median_time;
+use crate::fem::boundary::boundary_faces;
+use crate::fem::contact::{ContactProblem, ContactTolerances, Cylinder, PinMotion, solve_contact};
+use crate::fem::error::Result;
+use crate::fem::load::uniform_traction_with_resultant;
+use crate::fem::mesh::structured::{TwoEyePlate, two_eye_plate};
+use crate::fem::{Material, QuadratureChoice, StaticProblem, solve_static};
+
+/// The timings of [`bench_contact`].
+#[derive(Clone, Copy, Debug)]
+pub struct ContactBench {
+    /// Equations of the mesh.
+    pub dofs: usize,
+    /// Median wall time of the linear solve.
+    pub linear: Duration,
+    /// Median wall time of the contact solve.
+    pub contact: Duration,
+    /// contact / linear.
+    pub ratio: f64,
+    /// Contact rows and the compliance columns the active set needed.
+    pub rows: usize,
+    /// Columns computed.
+    pub columns: usize,
+}
+
+/// Times both solves `repeats` times on the plate with `n_side` divisions per bore quarter.
+pub fn bench_contact(n_side: usize, repeats: usize) -> Result<ContactBench> {
+    let plate = TwoEyePlate {
+        curved: true,
+        n_side,
+        n_radial: n_side / 2 + 1,
+        n_shank: n_side,
+        n_z: n_side / 2 + 1,
+        ..TwoEyePlate::default()
+    };
+    let mesh = two_eye_plate(&plate)?;
+    let faces = boundary_faces(&mesh)?;
+    let wall = |cx: f64, r: f64| -> Vec<[usize; 6]> {
+        faces
+            .iter()
+            .map(|f| f.nodes)
+            .filter(|f| {
+                f.iter().all(|&n| {
+                    let p = mesh.nodes()[n];
+                    ((p[0] - cx).hypot(p[1]) - r).abs() < 1e-9 * r
+                })
+            })
+            .collect()
+    };
+    let (fa, fb) = (
+        wall(0.0, plate.bore_a_radius),
+        wall(plate.length, plate.bore_b_radius),
+    );
+    let force = [20e3, 0.0, 0.0];
+    let material = Material::STEEL;
+    let mut fixed: Vec<usize> = fb.iter().flatten().copied().collect();
+    fixed.sort_unstable();
+    fixed.dedup();
+    let linear = StaticProblem {
+        mesh: &mesh,
+        material,
+        prescribed: fixed
+            .iter()
+            .flat_map(|&n| (0..3).map(move |j| (3 * n + j, 0.0)))
+            .collect(),
+        loads: vec![uniform_traction_with_resultant(&mesh, &fa, force)?.forces],
+        quadrature: QuadratureChoice::Auto,
+    };
+    let contact = ContactProblem {
+        mesh: &mesh,
+        material,
+        quadrature: QuadratureChoice::Auto,
+        prescribed: Vec::new(),
+        loads: Vec::new(),
+        cylinders: vec![
+            Cylinder {
+                axis_point_m: [0.0; 3],
+                axis: [0.0, 0.0, 1.0],
+                radius_m: plate.bore_a_radius - 20e-6,
+                faces: fa,
+                nominal_bore_radius_m: None,
+                motion: PinMotion::Force(force),
+            },
+            Cylinder {
+                axis_point_m: [plate.length, 0.0, 0.0],
+                axis: [0.0, 0.0, 1.0],
+                radius_m: plate.bore_b_radius - 10e-6,
+                faces: fb,
+                nominal_bore_radius_m: None,
+                motion: PinMotion::Fixed,
+            },
+        ],
+        tolerances: ContactTolerances::default(),
+    };
+    let (t_lin, lin) = median_time(repeats, || solve_static(&linear));
+    let dofs = lin?.stats.equations;
+    let (t_con, con) = median_time(repeats, || solve_contact(&contact));
+    let con = con?;
+    Ok(ContactBench {
+        dofs,
+        linear: t_lin,
+        contact: t_con,
+        ratio: t_con.as_secs_f64() / t_lin.as_secs_f64(),
+        rows: con.rows,
+        columns: con.columns,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_bench_runs_on_a_small_plate() {
+        let b = bench_contact(4, 1).unwrap();
+        assert!(b.columns <= b.rows && b.ratio > 0.0, "{b:?}");
+    }
+}
