@@ -3,6 +3,7 @@
 //! the records of [`crate::stages`] and [`crate::study`]; it computes nothing they report.
 
 pub mod atomic_write;
+pub mod columns;
 pub mod design_files;
 pub mod fields;
 pub mod index_page;

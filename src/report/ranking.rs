@@ -1,5 +1,6 @@
 //! The ranking (SPEC "Outputs"): one structure, three renderings (`ranking.md`, `ranking.csv`, the
-//! table of `index.html`), so every report gives the same order and the same columns.
+//! table of `index.html`), so every report gives the same order and the same columns (defined once,
+//! in [`super::columns`]).
 //!
 //! Order: designs that meet the stress criterion first, then by peak pin force, lowest first.
 //! Without the FEM stage no design is judged on stress and the order is by force alone. A design
@@ -12,7 +13,8 @@ use crate::stages::records::DesignDynamics;
 use crate::stages::records::DesignFem;
 use crate::study::results::{DesignResult, FailedDesign, StudyResults};
 use anyhow::Result;
-use serde::Serialize;
+
+use super::columns::{self, Showing};
 
 /// The verdict of one row.
 #[derive(Clone, Debug, PartialEq)]
@@ -184,130 +186,28 @@ pub fn ranking(results: &StudyResults) -> Vec<RankRow<'_>> {
     rows
 }
 
-/// One row of `ranking.csv` (SI units but stresses in MPa; empty where a stage was skipped or
-/// failed).
-#[derive(Serialize)]
-struct CsvRow<'a> {
-    rank: Option<usize>,
-    design: &'a str,
-    id: &'a str,
-    mass_kg: f64,
-    l1_m: f64,
-    i_zz_kgm2: f64,
-    i_xx_kgm2: f64,
-    peak_pin_force_n: Option<f64>,
-    /// With a pressure trace: the largest compression and tension along the rod axis (N, as
-    /// magnitudes) and their crank angles in [0, 720) degrees (columns only in the engine study).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    peak_compression_n: Option<Option<f64>>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    peak_compression_crank_angle_deg: Option<Option<f64>>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    peak_tension_n: Option<Option<f64>>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    peak_tension_crank_angle_deg: Option<Option<f64>>,
-    fx_von_mises_away_from_fixed_mpa: Option<f64>,
-    fx_estimated_error_rel: Option<f64>,
-    fx_von_mises_averaged_mpa: Option<f64>,
-    fx_von_mises_unaveraged_mpa: Option<f64>,
-    fy_von_mises_away_from_fixed_mpa: Option<f64>,
-    fy_estimated_error_rel: Option<f64>,
-    fy_von_mises_averaged_mpa: Option<f64>,
-    fy_von_mises_unaveraged_mpa: Option<f64>,
-    /// The cycle stage: max von Mises over one revolution (the four-stroke cycle with a trace;
-    /// inertia relief), its crank angle, and the smallest fatigue safety factor.
-    cycle_max_von_mises_mpa: Option<f64>,
-    cycle_crank_angle_of_max_deg: Option<f64>,
-    fatigue_safety_factor: Option<f64>,
-    /// The linear buckling load factor under the peak compression: a column only when some
-    /// design has one (the engine study), so that other rankings keep their bytes.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    buckling_load_factor: Option<Option<f64>>,
-    max_displacement_mm: Option<f64>,
-    /// On the Pareto front of mass, peak force and safety factor (`pareto.md`).
-    pareto_front: bool,
-    allowed_mpa: Option<f64>,
-    safety_factor: Option<f64>,
-    status: String,
-    /// `static`, `fatigue` or `static and fatigue` for a design that fails.
-    failing_on: String,
-    /// Where the linear model is out of its depth (beyond yield, large displacement), `; `-joined.
-    model_validity: String,
-    /// The failing stage's message, for a design that did not pass every stage.
-    error: String,
+/// Which optional columns the study shows ([`super::columns::Showing`]).
+pub fn showing(results: &StudyResults) -> Showing {
+    Showing {
+        engine: has_engine_loads(results),
+        buckling: has_buckling(results),
+    }
 }
 
-/// `ranking.csv`.
+/// `ranking.csv`: the columns of [`super::columns::COLUMNS`] (SI units but stresses in MPa; empty
+/// where a stage was skipped or failed).
 pub fn csv(results: &StudyResults) -> Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    let buckling = has_buckling(results);
-    let engine = has_engine_loads(results);
-    for r in ranking(results) {
-        let f = r.fem;
-        let d = r.dynamics;
-        let fx = f.and_then(|f| f.fem.cases.get("fx"));
-        let fy = f.and_then(|f| f.fem.cases.get("fy"));
-        w.serialize(CsvRow {
-            rank: r.rank,
-            design: &r.mass.design,
-            id: &r.mass.id,
-            mass_kg: r.mass.mass_kg,
-            l1_m: r.mass.l1_m,
-            i_zz_kgm2: r.mass.i_zz_kgm2,
-            i_xx_kgm2: r.mass.i_xx_kgm2,
-            peak_pin_force_n: r.peak_force_n(),
-            peak_compression_n: engine.then(|| d.and_then(|d| d.peak_compression_n)),
-            peak_compression_crank_angle_deg: engine
-                .then(|| d.and_then(|d| d.peak_compression_crank_angle_deg)),
-            peak_tension_n: engine.then(|| d.and_then(|d| d.peak_tension_n)),
-            peak_tension_crank_angle_deg: engine
-                .then(|| d.and_then(|d| d.peak_tension_crank_angle_deg)),
-            fx_von_mises_away_from_fixed_mpa: fx.map(|c| c.max_von_mises_away_from_fixed_mpa),
-            fx_estimated_error_rel: fx.map(|c| c.estimated_error_rel),
-            fx_von_mises_averaged_mpa: fx.map(|c| c.max_von_mises_averaged_mpa),
-            fx_von_mises_unaveraged_mpa: fx.map(|c| c.max_von_mises_unaveraged_mpa),
-            fy_von_mises_away_from_fixed_mpa: fy.map(|c| c.max_von_mises_away_from_fixed_mpa),
-            fy_estimated_error_rel: fy.map(|c| c.estimated_error_rel),
-            fy_von_mises_averaged_mpa: fy.map(|c| c.max_von_mises_averaged_mpa),
-            fy_von_mises_unaveraged_mpa: fy.map(|c| c.max_von_mises_unaveraged_mpa),
-            cycle_max_von_mises_mpa: r.cycle.map(|c| c.max_von_mises_over_cycle_mpa),
-            cycle_crank_angle_of_max_deg: r.cycle.map(|c| c.crank_angle_of_max_deg),
-            fatigue_safety_factor: r.cycle.map(|c| c.fatigue_safety_factor),
-            buckling_load_factor: buckling.then(|| f.and_then(|f| f.buckling_load_factor)),
-            max_displacement_mm: f.map(|f| f.fem.cases.max_of(|c| c.max_displacement_mm)),
-            pareto_front: r.pareto,
-            allowed_mpa: f.map(|f| f.criterion.allowed_mpa),
-            safety_factor: f.map(|f| f.criterion.safety_factor),
-            status: r.status.word(),
-            failing_on: r.failing_on(),
-            model_validity: r.model_validity(),
-            error: match &r.status {
-                Status::StageFailed { error, .. } => error.clone(),
-                _ => String::new(),
-            },
-        })?;
+    let showing = showing(results);
+    let rows = ranking(results);
+    if !rows.is_empty() {
+        w.write_record(columns::csv_header(showing))?;
+    }
+    for r in rows {
+        w.serialize(columns::csv_values(&r, showing))?;
     }
     Ok(w.into_inner()?)
 }
-
-/// The column headers of the ranking table for people (md and html).
-pub const HEADERS: [&str; 15] = [
-    "rank",
-    "design",
-    "status",
-    "safety factor",
-    "σ F_x [MPa]",
-    "σ F_y [MPa]",
-    "σ max over the cycle [MPa]",
-    "fatigue safety factor",
-    "peak pin force [N]",
-    "mass [kg]",
-    "l1 [mm]",
-    "I_zz [kg·m²]",
-    "I_xx [kg·m²]",
-    "max displ. [mm]",
-    "Pareto front",
-];
 
 /// Whether any design of the study has a buckling load factor (then the tables get its column).
 pub fn has_buckling(results: &StudyResults) -> bool {
@@ -318,11 +218,6 @@ pub fn has_buckling(results: &StudyResults) -> bool {
     })
 }
 
-/// The header of the buckling column, placed after [`BUCKLING_AFTER`] columns.
-pub const BUCKLING_HEADER: &str = "buckling load factor";
-/// Columns of [`HEADERS`] before the buckling column (after the fatigue safety factor).
-pub const BUCKLING_AFTER: usize = 8;
-
 /// Whether any design has the engine's axial peaks (a study with a pressure trace): then the
 /// tables get the peak compression and tension columns after the peak pin force.
 pub fn has_engine_loads(results: &StudyResults) -> bool {
@@ -330,139 +225,6 @@ pub fn has_engine_loads(results: &StudyResults) -> bool {
         .designs
         .iter()
         .any(|d| d.dynamics.peak_compression_n.is_some())
-}
-
-/// The headers of the engine columns, placed after [`ENGINE_AFTER`] columns of [`HEADERS`].
-pub const ENGINE_HEADERS: [&str; 2] = ["peak compression [N] at φ", "peak tension [N] at φ"];
-/// Columns of [`HEADERS`] before the engine columns (after the peak pin force).
-pub const ENGINE_AFTER: usize = 9;
-
-/// The optional columns of the study's table.
-#[derive(Clone, Copy, Debug)]
-pub struct TableColumns {
-    /// The buckling load factor ([`has_buckling`]).
-    pub buckling: bool,
-    /// Peak compression and tension ([`has_engine_loads`]).
-    pub engine: bool,
-}
-
-impl TableColumns {
-    pub fn of(results: &StudyResults) -> TableColumns {
-        TableColumns {
-            buckling: has_buckling(results),
-            engine: has_engine_loads(results),
-        }
-    }
-}
-
-/// The headers of the study's table: [`HEADERS`], with the engine columns and the buckling
-/// column when any design has them.
-pub fn table_headers(results: &StudyResults) -> Vec<&'static str> {
-    let cols = TableColumns::of(results);
-    let mut h = HEADERS.to_vec();
-    if cols.engine {
-        for (k, e) in ENGINE_HEADERS.iter().enumerate() {
-            h.insert(ENGINE_AFTER + k, e);
-        }
-    }
-    if cols.buckling {
-        h.insert(BUCKLING_AFTER, BUCKLING_HEADER);
-    }
-    h
-}
-
-/// The cells of one row in [`table_headers`] order.
-pub fn table_cells(r: &RankRow, cols: TableColumns) -> Vec<String> {
-    let mut c = cells(r).to_vec();
-    if cols.engine {
-        let peak = |n: Option<f64>, at: Option<f64>| match (n, at) {
-            (Some(n), Some(at)) => format!("{n:.0} at {at:.0}°"),
-            _ => "—".to_string(),
-        };
-        let d = r.dynamics;
-        c.insert(
-            ENGINE_AFTER,
-            peak(
-                d.and_then(|d| d.peak_compression_n),
-                d.and_then(|d| d.peak_compression_crank_angle_deg),
-            ),
-        );
-        c.insert(
-            ENGINE_AFTER + 1,
-            peak(
-                d.and_then(|d| d.peak_tension_n),
-                d.and_then(|d| d.peak_tension_crank_angle_deg),
-            ),
-        );
-    }
-    if cols.buckling {
-        c.insert(
-            BUCKLING_AFTER,
-            r.fem
-                .and_then(|f| f.buckling_load_factor)
-                .map_or_else(|| "—".to_string(), |l| format!("{l:.2}")),
-        );
-    }
-    c
-}
-
-/// The cells of one row of the table for people, in [`HEADERS`] order (plain text).
-pub fn cells(r: &RankRow) -> [String; 15] {
-    let dash = || "—".to_string();
-    let stress = |c: Option<&crate::rod::LoadCaseResult>| {
-        c.map_or_else(dash, |c| {
-            format!(
-                "{:.1} ± {:.1} % / {:.1} / {:.1}",
-                c.max_von_mises_away_from_fixed_mpa,
-                100.0 * c.estimated_error_rel,
-                c.max_von_mises_averaged_mpa,
-                c.max_von_mises_unaveraged_mpa
-            )
-        })
-    };
-    let f = r.fem;
-    let alone = if is_rod_body_alone(r.mass) {
-        ROD_BODY_ALONE.to_string()
-    } else {
-        String::new()
-    };
-    let notes: Vec<String> = [r.failing_on(), r.model_validity(), alone]
-        .into_iter()
-        .filter(|s| !s.is_empty())
-        .collect();
-    [
-        r.rank.map_or_else(dash, |k| k.to_string()),
-        r.mass.design.clone(),
-        if notes.is_empty() {
-            r.status.word()
-        } else {
-            format!("{} ({})", r.status.word(), notes.join("; "))
-        },
-        f.map_or_else(dash, |f| format!("{:.2}", f.criterion.safety_factor)),
-        stress(f.and_then(|f| f.fem.cases.get("fx"))),
-        stress(f.and_then(|f| f.fem.cases.get("fy"))),
-        r.cycle.map_or_else(dash, |c| {
-            format!(
-                "{:.1} at φ = {:.0}°",
-                c.max_von_mises_over_cycle_mpa, c.crank_angle_of_max_deg
-            )
-        }),
-        r.cycle
-            .map_or_else(dash, |c| format!("{:.2}", c.fatigue_safety_factor)),
-        r.peak_force_n().map_or_else(dash, |v| format!("{v:.1}")),
-        format!("{:.4}", r.mass.mass_kg),
-        format!("{:.2}", r.mass.l1_m * 1e3),
-        format!("{:.5}", r.mass.i_zz_kgm2),
-        format!("{:.6}", r.mass.i_xx_kgm2),
-        f.map_or_else(dash, |f| {
-            format!("{:.4}", f.fem.cases.max_of(|c| c.max_displacement_mm))
-        }),
-        if r.pareto {
-            "yes".into()
-        } else {
-            String::new()
-        },
-    ]
 }
 
 /// The sentence that says how the ranking orders and what the stress columns hold.
@@ -620,14 +382,14 @@ pub const VALIDITY_PREAMBLE: &str = "The stage-3 model is linear elastic and sma
 /// `ranking.md`.
 pub fn markdown(results: &StudyResults) -> String {
     let mut out = format!("# Ranking of the designs\n\n{}\n\n", explanation(results));
-    let headers = table_headers(results);
-    let cols = TableColumns::of(results);
+    let showing = showing(results);
+    let headers = columns::table_headers(showing);
     out.push_str(&format!("| {} |\n", headers.join(" | ")));
     out.push_str(&format!("|{}\n", "---|".repeat(headers.len())));
     for r in ranking(results) {
-        let cells: Vec<String> = table_cells(&r, cols)
+        let cells: Vec<String> = columns::table_cells(&r, showing)
             .into_iter()
-            .map(|c| c.replace('|', "\\|"))
+            .map(|(_, c)| c.replace('|', "\\|"))
             .collect();
         out.push_str(&format!("| {} |\n", cells.join(" | ")));
     }
@@ -680,9 +442,9 @@ pub fn escape(s: &str) -> String {
 /// ranking order); the design names link to their sections (`#<id>`).
 pub fn html_table(results: &StudyResults) -> String {
     let mut out = String::from("<table id=\"ranking\">\n<thead><tr>");
-    let cols = TableColumns::of(results);
-    for h in table_headers(results) {
-        out.push_str(&format!("<th>{}</th>", escape(h)));
+    let showing = showing(results);
+    for h in columns::table_headers(showing) {
+        out.push_str(&format!("<th>{}</th>", escape(&h)));
     }
     out.push_str("</tr></thead>\n<tbody>\n");
     for r in ranking(results) {
@@ -691,9 +453,9 @@ pub fn html_table(results: &StudyResults) -> String {
             "<tr data-id=\"{id}\" class=\"{}\">",
             r.status.class()
         ));
-        for (k, c) in table_cells(&r, cols).iter().enumerate() {
-            let c = escape(c);
-            if k == 1 {
+        for (key, c) in columns::table_cells(&r, showing) {
+            let c = escape(&c);
+            if key == "design" {
                 out.push_str(&format!("<td><a href=\"#{id}\">{c}</a></td>"));
             } else {
                 out.push_str(&format!("<td>{c}</td>"));
