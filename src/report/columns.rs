@@ -49,19 +49,32 @@ pub enum Shown {
     Buckling,
 }
 
+/// A design's CSV field: its name and value.
+pub type DesignField = (&'static str, fn(&RankRow) -> Value);
+/// A design's cell for people: its header and text.
+pub type DesignCell = (&'static str, fn(&RankRow) -> String);
+/// A case's CSV field: the name after the case's and the value.
+pub type CaseField = (&'static str, fn(Option<&LoadCaseResult>) -> Value);
+/// A case's cell for people: the header before and after the case's label, and the text.
+pub type CaseCell = (
+    &'static str,
+    &'static str,
+    fn(Option<&LoadCaseResult>) -> String,
+);
+
 /// What a column holds.
 pub enum Cells {
     /// A figure of the design.
     Design {
         /// The CSV fields: name and value.
-        csv: &'static [(&'static str, fn(&RankRow) -> Value)],
+        csv: &'static [DesignField],
         /// The header and the cell in the table for people.
-        table: Option<(&'static str, fn(&RankRow) -> String)>,
+        table: Option<DesignCell>,
     },
     /// A figure per load case.
     PerCase {
         /// The CSV fields: the name after the case's (`{case}_{suffix}`) and the value.
-        csv: &'static [(&'static str, fn(Option<&LoadCaseResult>) -> Value)],
+        csv: &'static [CaseField],
         /// The header around the case's label (`{before}{label}{after}`) and the cell.
         table: Option<(
             &'static str,
