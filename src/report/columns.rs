@@ -76,11 +76,7 @@ pub enum Cells {
         /// The CSV fields: the name after the case's (`{case}_{suffix}`) and the value.
         csv: &'static [CaseField],
         /// The header around the case's label (`{before}{label}{after}`) and the cell.
-        table: Option<(
-            &'static str,
-            &'static str,
-            fn(Option<&LoadCaseResult>) -> String,
-        )>,
+        table: Option<CaseCell>,
     },
 }
 
