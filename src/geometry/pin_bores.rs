@@ -3,9 +3,9 @@
 //! bore the geometry shows holds it), and a sidecar's pin agrees with the bore that sits there
 //! (inside the part, on the bore's axis, along the bore's axis).
 
-use super::bore_check::RodSurface;
+use super::bore_check::{RodSurface, first_in_plane_hits};
 use super::bore_finder::FoundPins;
-use super::bore_finder::{Bore, find_bores};
+use super::bore_finder::{Bore, find_bores, smooth_patches_through};
 use super::sidecar::Units;
 use super::weld::IndexedMesh;
 use anyhow::{Result, bail};
@@ -94,7 +94,7 @@ pub(super) fn pin_bore(
     match surface.bore_radius(name, centre, axis, scale, units) {
         Ok(radius) => {
             if d.from_sidecar {
-                let near = find_bores(&around_the_axis(d.mesh, centre, axis, 2.0 * radius));
+                let near = bores_around_the_pin(d.mesh, centre, axis, radius);
                 pin_on_the_bores_axis(d, &near, name, centre, axis, warnings)?;
             }
             Ok(PinBore {
@@ -153,16 +153,18 @@ pub(super) fn pin_bore(
     }
 }
 
-/// The triangles of `mesh` with a corner within `reach` of the line through `centre` along
-/// `axis`: where the bore around a pin is, for the bore finder to fit that bore without
-/// searching the whole part. Their vertices keep their order (renumbered without the gaps), so
-/// the finder sees the same edge order and fits the same points as on the whole vertex list.
-fn around_the_axis(
+/// The bores of the wall around a sidecar's pin whose in-plane rays met a wall `radius` away:
+/// the smooth patches of the surface within 2·`radius` of the pin's axis that hold the
+/// triangles those rays meet first, given to the bore finder on their own. The rest of the
+/// part (the eye's faces, its outline, the shank) is not searched: on design 1 subdivided to
+/// 1.6 M triangles the crank's wall is 13 % of them.
+fn bores_around_the_pin(
     mesh: &IndexedMesh,
     centre: Vector3<f64>,
     axis: Vector3<f64>,
-    reach: f64,
-) -> IndexedMesh {
+    radius: f64,
+) -> Vec<Bore> {
+    let reach = 2.0 * radius;
     let near: Vec<bool> = mesh
         .vertices
         .par_iter()
@@ -171,11 +173,23 @@ fn around_the_axis(
             (d - axis * axis.dot(&d)).norm() <= reach
         })
         .collect();
-    let triangles: Vec<[u32; 3]> = mesh
-        .triangles
-        .par_iter()
-        .filter(|t| t.iter().any(|&v| near[v as usize]))
-        .copied()
+    let around: Vec<u32> = (0..mesh.triangles.len() as u32)
+        .into_par_iter()
+        .filter(|&t| mesh.triangles[t as usize].iter().any(|&v| near[v as usize]))
+        .collect();
+    let around = restricted(mesh, &around);
+    let seeds = first_in_plane_hits(&around, centre, axis);
+    let wall = smooth_patches_through(&around, &seeds);
+    find_bores(&restricted(&around, &wall))
+}
+
+/// The triangles `triangles` (increasing) of `mesh` on their own, their vertices in the same
+/// order without the gaps: the bore finder sees the same edge order and fits the same points as
+/// it would on the whole vertex list.
+fn restricted(mesh: &IndexedMesh, triangles: &[u32]) -> IndexedMesh {
+    let triangles: Vec<[u32; 3]> = triangles
+        .iter()
+        .map(|&t| mesh.triangles[t as usize])
         .collect();
     let mut used = vec![false; mesh.vertices.len()];
     for &v in triangles.iter().flatten() {

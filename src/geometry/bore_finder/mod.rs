@@ -43,7 +43,7 @@ mod tests;
 mod walls;
 
 pub use bore::*;
-pub use walls::find_bores;
+pub use walls::{find_bores, smooth_patches_through};
 
 use fit::canonical;
 

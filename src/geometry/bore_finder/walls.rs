@@ -415,6 +415,71 @@ pub(super) fn describe_wall(
     }
 }
 
+/// The triangles of the smooth patches that hold `seeds`, in increasing order: the patches of
+/// [`smooth_patches`] (joined across manifold edges, two uses, whose dihedral angle is below
+/// [`SMOOTH_ANGLE_DEG`]), found by walking from the seeds, so that the rest of the surface costs
+/// one pass to list each vertex's triangles.
+pub fn smooth_patches_through(mesh: &IndexedMesh, seeds: &[u32]) -> Vec<u32> {
+    let n = mesh.triangles.len();
+    let mut start = vec![0u32; mesh.vertices.len() + 1];
+    for &v in mesh.triangles.iter().flatten() {
+        start[v as usize + 1] += 1;
+    }
+    for v in 0..mesh.vertices.len() {
+        start[v + 1] += start[v];
+    }
+    let mut next = start.clone();
+    let mut around = vec![0u32; 3 * n];
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        for &v in tri {
+            around[next[v as usize] as usize] = t as u32;
+            next[v as usize] += 1;
+        }
+    }
+    // the unit normal as `find_bores` forms it
+    let normal = |t: u32| {
+        let [a, b, c] = mesh.corners(t as usize);
+        let n = (b - a).cross(&(c - a));
+        let twice = n.norm();
+        if twice > 0.0 {
+            n / twice
+        } else {
+            Vector3::zeros()
+        }
+    };
+    let cos_max = SMOOTH_ANGLE_DEG.to_radians().cos();
+    let mut seen = vec![false; n];
+    let mut patch: Vec<u32> = Vec::new();
+    let mut queue: Vec<u32> = Vec::new();
+    for &s in seeds {
+        if !seen[s as usize] {
+            seen[s as usize] = true;
+            queue.push(s);
+        }
+    }
+    while let Some(t) = queue.pop() {
+        patch.push(t);
+        let [a, b, c] = mesh.triangles[t as usize];
+        let nt = normal(t);
+        for (i, j) in [(a, b), (b, c), (c, a)] {
+            let users = &around[start[i as usize] as usize..start[i as usize + 1] as usize];
+            let mut other = users
+                .iter()
+                .filter(|&&u| u != t && mesh.triangles[u as usize].contains(&j));
+            // a manifold edge: exactly one other triangle uses it
+            let (Some(&u), None) = (other.next(), other.next()) else {
+                continue;
+            };
+            if !seen[u as usize] && normal(u).dot(&nt) >= cos_max {
+                seen[u as usize] = true;
+                queue.push(u);
+            }
+        }
+    }
+    patch.sort_unstable();
+    patch
+}
+
 /// Every bore of the surface (any arc), merged, largest wall area first.
 pub fn find_bores(mesh: &IndexedMesh) -> Vec<Bore> {
     let normals_areas: Vec<(Vector3<f64>, f64)> = (0..mesh.triangles.len())
