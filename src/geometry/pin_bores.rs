@@ -247,8 +247,8 @@ fn sidecar_pin_in_the_part(d: &PinsView<'_>, name: &str, centre: Vector3<f64>) -
 }
 
 /// A sidecar's pin must sit on the axis of the bore around it: the bore the geometry shows
-/// there (found as the pin search finds bores; within the bore's radius of the pin, its axis
-/// parallel) may lie 1 % of its radius from the pin unremarked, up to 5 % with a warning (a pin
+/// there (found as the pin search finds bores, on the wall around the pin:
+/// [`bores_around_the_pin`]; within the bore's radius of the pin, its axis parallel) may lie 1 % of its radius from the pin unremarked, up to 5 % with a warning (a pin
 /// rounded to 0.1 mm in a small bore), beyond that the design is refused. A pin off the centre
 /// still sees a wall all round, so the bore check alone would pass it and measure the wrong
 /// radius and centre distance.
