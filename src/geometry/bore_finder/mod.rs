@@ -38,12 +38,14 @@ use nalgebra::Vector3;
 
 mod bore;
 mod fit;
+mod patches;
 #[cfg(test)]
 mod tests;
 mod walls;
 
 pub use bore::*;
-pub use walls::{find_bores, smooth_patches_through};
+pub use patches::smooth_patches_through;
+pub use walls::find_bores;
 
 use fit::canonical;
 

@@ -283,7 +283,7 @@ fn equal_radii_are_refused_and_three_holes_give_the_ends() {
 }
 
 /// The walk from seeds gives each smooth patch as the union–find over the sorted edges does
-/// (the second method, `walls::smooth_patches`), on a plate with a full and a half hole.
+/// (the second method, `patches::smooth_patches`), on a plate with a full and a half hole.
 #[test]
 fn the_walk_from_a_seed_gives_its_smooth_patch() {
     let m = as_read(&rod(&[
@@ -304,7 +304,7 @@ fn the_walk_from_a_seed_gives_its_smooth_patch() {
             (b - a).cross(&(c - a)).normalize()
         })
         .collect();
-    let (patches, _) = super::walls::smooth_patches(&m, &normals);
+    let (patches, _) = super::patches::smooth_patches(&m, &normals);
     assert!(patches.len() > 3, "{}", patches.len());
     for patch in &patches {
         let middle = patch[patch.len() / 2];
