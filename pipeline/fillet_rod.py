@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""A rod with fillets like the designs, for the accuracy of rodstudy's adaptive FEM (issue 10).
+"""A rod with fillets like the designs, for the accuracy of rodstudy's adaptive FEM.
 
 The rod is built exactly as `make_designs.py` builds its rods (OpenCASCADE through gmsh: big-end
 eye with bolt bosses, small-end eye, a solid tapered shank, every z-parallel junction edge filleted
@@ -13,7 +13,7 @@ parameters (no calibration), so the exact B-rep is known and reproducible.
       curvature (a kink of 360/N degrees between facets), sizes between MIN and MAX. A CAD export
       that tessellates by chord alone has no MAX: `--per-turn 24 --max-size 200` covers the flat
       shank faces with two triangles each and the R8 fillets with 15 degree strips, 40 mm long
-      (the size-floor case of issue 18).
+      (the case of the loop's size floor).
 
   fillet_rod.py step OUT.step [--design N]
       The exact B-rep of the same rod (or of design N) as a STEP file in mm, as a CAD system exports

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Connecting rods drawn the way other people draw them, as test data for rodstudy (issue 18 item 6).
+"""Connecting rods drawn the way other people draw them, as test data for rodstudy.
 
 Not the designs of `make_designs.py`: each rod here breaks one habit of those designs, so that the
 bore finder, the validator and the mass stage meet what real CAD exports look like.
@@ -16,8 +16,8 @@ bore finder, the validator and the mass stage meet what real CAD exports look li
                fillet (the shank-to-eye junctions and the steps from the shank faces to the eyes),
                also exported as NAME_chord.stl: 24 elements per turn but none below 0.8 mm, as an
                export with a minimum facet size (or a 0.1 mm chord tolerance) cuts a small fillet:
-               each R1 fillet in two facets, kinks of 45°, above a 40° feature angle (issue 18
-               item 5: a fillet, not a sharp edge)
+               each R1 fillet in two facets, kinks of 45°, above a 40° feature angle (a fillet,
+               not a sharp edge)
 
 Each rod is built with gmsh's OpenCASCADE kernel (as `make_designs.py` and `fillet_rod.py`) and
 written as NAME.step (the exact B-rep) and as binary STL at two chord tolerances: NAME_coarse.stl

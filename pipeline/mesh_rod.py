@@ -176,7 +176,7 @@ def fixed_allocator() -> None:
     collects them in a `std::set<MVertex *>`), and HXT's optimiser decides its ties in that order:
     the same model and size field made 12,228 or 12,229 nodes depending on what the process had
     allocated before (its paths' lengths, earlier meshes), and a fresh clone of the project in
-    another folder made another design 5 (issue 21, session 29). So every mesh is made in a thread
+    another folder made another design 5. So every mesh is made in a thread
     of its own (`in_fresh_arena`): glibc gives a new thread a new arena, whose blocks it hands out
     in the order the meshing asks for them, whatever the process did before. Two settings keep it
     so: the size above which a block is mapped on its own is fixed (glibc raises it as mapped
@@ -283,8 +283,8 @@ def gmsh_options(size_mm: float, curved: bool, size_field: bool = False) -> dict
         # default 1e-9 made gmsh evaluate the piecewise-linear field so often that the 1D mesh
         # took 0.8 s of a 1.5 s mesh (design 1); 1e-6 took 0.23 s on the whole rod, but 0.5-1.1 s
         # of a half model's later mesh (its cut's long curves); 1e-3 takes 0.15-0.36 s there
-        # (issue 21, session 29; the node spacing along a curve moves by far less than the
-        # element sizes the loop asks for)
+        # (the node spacing along a curve moves by far less than the element sizes the loop
+        # asks for)
         opts["Mesh.LcIntegrationPrecision"] = 1e-3
     else:
         opts["Mesh.LcIntegrationPrecision"] = 1e-9  # gmsh's default (a session's later mesh resets it)

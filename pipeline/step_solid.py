@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""A STEP design read through gmsh's OpenCASCADE kernel, for rodstudy's stage 1 (issue 18).
+"""A STEP design read through gmsh's OpenCASCADE kernel, for rodstudy's stage 1.
 
   step_solid.py read FILE.step OUT.stl [--fine]
 

@@ -86,7 +86,7 @@ non-numbers and unknown kinds are errors (exit status 2). Example (TOML):
     kind = ["ibeam", "slot"]
     eye_t = { min = 38.0, max = 42.0 }
     shank_h = { max = 22.0 }
-    fillet_r = { min = 5.0, max = 9.0 }      # also sampled now
+    fillet_r = { min = 5.0, max = 9.0 }      # sampled too
 
 or as JSON: {"kind": ["ibeam", "slot"], "eye_t": {"min": 38, "max": 42}, "shank_h": {"max": 22}}
 

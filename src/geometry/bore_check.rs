@@ -198,6 +198,46 @@ impl<'a> RodSurface<'a> {
     }
 }
 
+/// The triangles of `mesh` the [`IN_PLANE_RAYS`] rays from `centre` across `axis` meet first
+/// (the directions of [`RodSurface::probe`]), each once: the wall around a pin.
+pub fn first_in_plane_hits(
+    mesh: &IndexedMesh,
+    centre: Vector3<f64>,
+    axis: Vector3<f64>,
+) -> Vec<u32> {
+    let axis = axis.normalize();
+    let u = axis
+        .cross(&if axis.x.abs() < 0.9 {
+            Vector3::x()
+        } else {
+            Vector3::y()
+        })
+        .normalize();
+    let v = axis.cross(&u);
+    let across_plane: Vec<u32> = (0..mesh.triangles.len() as u32)
+        .filter(|&t| {
+            let ws = mesh.corners(t as usize).map(|p| (p - centre).dot(&axis));
+            ws.iter().any(|&w| w <= 0.0) && ws.iter().any(|&w| w >= 0.0)
+        })
+        .collect();
+    let mut first: Vec<u32> = (0..IN_PLANE_RAYS)
+        .filter_map(|k| {
+            let angle = std::f64::consts::TAU * k as f64 / IN_PLANE_RAYS as f64;
+            let dir = u * angle.cos() + v * angle.sin();
+            across_plane
+                .iter()
+                .filter_map(|&t| {
+                    ray_triangle(centre, dir, mesh.corners(t as usize)).map(|d| (d, t))
+                })
+                .min_by(|x, y| x.0.total_cmp(&y.0))
+                .map(|(_, t)| t)
+        })
+        .collect();
+    first.sort_unstable();
+    first.dedup();
+    first
+}
+
 /// A point in the file's units, as messages show it.
 fn shown(centre: Vector3<f64>, scale: f64, units: &str) -> String {
     let p = centre / scale;

@@ -515,7 +515,7 @@ fn rod_record(d: &LoadedDesign, stl: &Path) -> Result<DesignMass> {
     let surface = RodSurface::new(&d.mesh).with_context(file)?;
     let mut warnings = Vec::new();
     // the bores the geometry shows, once, for sidecar pins to be checked against
-    let bores = std::cell::OnceCell::new();
+    let bores = std::sync::OnceLock::new();
     let view = PinsView {
         mesh: &d.mesh,
         units: d.settings.units,
@@ -526,7 +526,14 @@ fn rod_record(d: &LoadedDesign, stl: &Path) -> Result<DesignMass> {
         axis_given: d.settings.pin_axis.is_some(),
         found: d.pins.found.as_ref(),
     };
-    let crank = pin_bore(&view, &surface, Pin::Crank, &bores, &mut warnings).with_context(file);
+    // the two pins side by side, their warnings in order (the crank's first)
+    let bore_of = |pin| {
+        let mut warnings = Vec::new();
+        let r = pin_bore(&view, &surface, pin, &bores, &mut warnings).with_context(file);
+        (r, warnings)
+    };
+    let ((crank, crank_warnings), (piston, piston_warnings)) =
+        rayon::join(|| bore_of(Pin::Crank), || bore_of(Pin::Piston));
     let crank = match (crank, &d.pins.search_error) {
         (Err(e), Some(why)) => {
             return Err(e.context(format!(
@@ -537,8 +544,9 @@ fn rod_record(d: &LoadedDesign, stl: &Path) -> Result<DesignMass> {
         }
         (r, _) => r?,
     };
-    let piston =
-        pin_bore(&view, &surface, Pin::Piston, &bores, &mut warnings).with_context(file)?;
+    warnings.extend(crank_warnings);
+    let piston = piston?;
+    warnings.extend(piston_warnings);
     if d.pins.source == PinsSource::Sidecar && crank.radius < 0.95 * piston.radius {
         let mm = 1.0 / d.settings.units.to_metres();
         let u = d.settings.units.symbol();

@@ -288,8 +288,8 @@ mod tests {
         *Rotation3::from_euler_angles(0.3, -1.1, 2.4).matrix()
     }
 
-    /// The moments as the nalgebra expressions of the formulas give them (the code before the
-    /// plain-f64 kernel), chunked and summed in the same order.
+    /// The moments as the nalgebra expressions of the formulas give them (a second spelling of
+    /// the plain-f64 kernel), chunked and summed in the same order.
     fn nalgebra_moments(mesh: &IndexedMesh, reference: Vector3<f64>) -> VolumeMoments {
         let zero = VolumeMoments {
             volume: 0.0,

@@ -1,6 +1,6 @@
 //! Regression test: rows of the work–precision table (`reports/work_precision.csv`, scene
-//! `free` of thesis ch. 4) pinned as recorded before the adaptive methods were given their
-//! shared loop ([`super::adaptive`]) and the crate its one dense LU. A change of any
+//! `free` of thesis ch. 4) pinned to recorded values: the counters and errors of each adaptive
+//! method on the shared loop ([`super::adaptive`]) with the crate's one dense LU. A change of any
 //! counter, or of an error beyond rounding, is a change of behaviour.
 
 use super::{SolverOptions, solve};

@@ -38,11 +38,13 @@ use nalgebra::Vector3;
 
 mod bore;
 mod fit;
+mod patches;
 #[cfg(test)]
 mod tests;
 mod walls;
 
 pub use bore::*;
+pub use patches::smooth_patches_through;
 pub use walls::find_bores;
 
 use fit::canonical;

@@ -281,3 +281,37 @@ fn equal_radii_are_refused_and_three_holes_give_the_ends() {
     let e = find_pins(&m, Some(Vector3::y()), Units::Mm).unwrap_err();
     assert!(matches!(e, PinSearchError::NoBore(_)), "{e}");
 }
+
+/// The walk from seeds gives each smooth patch as the union–find over the sorted edges does
+/// (the second method, `patches::smooth_patches`), on a plate with a full and a half hole.
+#[test]
+fn the_walk_from_a_seed_gives_its_smooth_patch() {
+    let m = as_read(&rod(&[
+        Hole {
+            x: 0.0,
+            r: 20.0,
+            half: true,
+        },
+        Hole {
+            x: 100.0,
+            r: 12.0,
+            half: false,
+        },
+    ]));
+    let normals: Vec<Vector3<f64>> = (0..m.triangles.len())
+        .map(|t| {
+            let [a, b, c] = m.corners(t);
+            (b - a).cross(&(c - a)).normalize()
+        })
+        .collect();
+    let (patches, _) = super::patches::smooth_patches(&m, &normals);
+    assert!(patches.len() > 3, "{}", patches.len());
+    for patch in &patches {
+        let middle = patch[patch.len() / 2];
+        assert_eq!(&smooth_patches_through(&m, &[middle]), patch);
+    }
+    let two = [patches[0][0], patches[1][0]];
+    let mut both: Vec<u32> = patches[0].iter().chain(&patches[1]).copied().collect();
+    both.sort_unstable();
+    assert_eq!(smooth_patches_through(&m, &two), both);
+}

@@ -4,65 +4,11 @@
 
 use super::bore::*;
 use super::fit::*;
+use super::patches::smooth_patches;
 use crate::geometry::weld::IndexedMesh;
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
+use rayon::prelude::*;
 use std::f64::consts::{PI, TAU};
-
-/// Smooth patches: triangle groups joined across manifold edges with small dihedral angles;
-/// and each triangle's neighbours across its manifold edges (`u32::MAX`: none).
-pub(super) fn smooth_patches(
-    mesh: &IndexedMesh,
-    normals: &[Vector3<f64>],
-) -> (Vec<Vec<u32>>, Vec<[u32; 3]>) {
-    let n = mesh.triangles.len();
-    let mut uses: Vec<(u64, u32)> = Vec::with_capacity(3 * n);
-    for (t, &[a, b, c]) in mesh.triangles.iter().enumerate() {
-        for (i, j) in [(a, b), (b, c), (c, a)] {
-            uses.push(((u64::from(i.min(j)) << 32) | u64::from(i.max(j)), t as u32));
-        }
-    }
-    uses.sort_unstable();
-    let mut parent: Vec<u32> = (0..n as u32).collect();
-    fn root(parent: &mut [u32], mut i: u32) -> u32 {
-        while parent[i as usize] != i {
-            parent[i as usize] = parent[parent[i as usize] as usize];
-            i = parent[i as usize];
-        }
-        i
-    }
-    let cos_max = SMOOTH_ANGLE_DEG.to_radians().cos();
-    let mut neighbours = vec![[u32::MAX; 3]; n];
-    let mut link = |a: u32, b: u32| {
-        if let Some(slot) = neighbours[a as usize].iter_mut().find(|x| **x == u32::MAX) {
-            *slot = b;
-        }
-    };
-    for group in uses.chunk_by(|x, y| x.0 == y.0) {
-        if let [(_, s), (_, t)] = *group {
-            link(s, t);
-            link(t, s);
-        }
-        if let [(_, s), (_, t)] = *group
-            && normals[s as usize].dot(&normals[t as usize]) >= cos_max
-        {
-            let (ra, rb) = (root(&mut parent, s), root(&mut parent, t));
-            if ra != rb {
-                parent[ra.max(rb) as usize] = ra.min(rb);
-            }
-        }
-    }
-    let mut index = vec![u32::MAX; n];
-    let mut patches: Vec<Vec<u32>> = Vec::new();
-    for t in 0..n as u32 {
-        let r = root(&mut parent, t) as usize;
-        if index[r] == u32::MAX {
-            index[r] = patches.len() as u32;
-            patches.push(Vec::new());
-        }
-        patches[index[r] as usize].push(t);
-    }
-    (patches, neighbours)
-}
 
 /// A fitted concave cylindrical patch before merging.
 pub(super) struct Wall {
@@ -158,10 +104,11 @@ pub(super) fn cylinders_in(
     normals_areas: &[(Vector3<f64>, f64)],
     neighbours: &[[u32; 3]],
     patch: &[u32],
-    inside: impl Fn(u32) -> bool,
+    inside: impl Fn(u32) -> bool + Sync,
 ) -> Vec<Vec<u32>> {
-    use std::collections::HashSet;
-    let mut taken: HashSet<u32> = HashSet::new();
+    // `taken`: in a region already; `member`: in the region being grown, stamped with its seed
+    let mut taken = vec![false; mesh.triangles.len()];
+    let mut member = vec![u32::MAX; mesh.triangles.len()];
     let mut parts = Vec::new();
     let next_to = |t: u32| {
         neighbours[t as usize]
@@ -169,8 +116,9 @@ pub(super) fn cylinders_in(
             .filter(|&s| s != u32::MAX && inside(s))
     };
     let max_tilt = GROW_TILT_DEG.to_radians().sin();
-    for &seed in patch {
-        if taken.contains(&seed) {
+    let flat = flat_rings(normals_areas, neighbours, patch, &inside);
+    for (&seed, flat) in patch.iter().zip(flat) {
+        if taken[seed as usize] || flat {
             continue;
         }
         // two rings around the seed
@@ -180,7 +128,7 @@ pub(super) fn cylinders_in(
             let now = ring.clone();
             for t in now {
                 for s in next_to(t) {
-                    if !ring.contains(&s) && !taken.contains(&s) {
+                    if !ring.contains(&s) && !taken[s as usize] {
                         ring.push(s);
                     }
                 }
@@ -212,17 +160,20 @@ pub(super) fn cylinders_in(
             if !fits(seed, &cyl) {
                 break;
             }
-            let mut member: HashSet<u32> = HashSet::from([seed]);
+            // the stamp of this growth: the seed and the round
+            let stamp = 2 * seed + round;
+            member[seed as usize] = stamp;
+            region = vec![seed];
             let mut queue = vec![seed];
             while let Some(t) = queue.pop() {
                 for s in next_to(t) {
-                    if !taken.contains(&s) && !member.contains(&s) && fits(s, &cyl) {
-                        member.insert(s);
+                    if !taken[s as usize] && member[s as usize] != stamp && fits(s, &cyl) {
+                        member[s as usize] = stamp;
+                        region.push(s);
                         queue.push(s);
                     }
                 }
             }
-            region = member.into_iter().collect();
             region.sort_unstable();
             if round == 0 {
                 match fit_cylinder(&patch_vertices(mesh, &region), cyl.axis) {
@@ -232,11 +183,41 @@ pub(super) fn cylinders_in(
             }
         }
         if region.len() >= 6 {
-            taken.extend(region.iter().copied());
+            for &t in &region {
+                taken[t as usize] = true;
+            }
             parts.push(region);
         }
     }
     parts
+}
+
+/// For each seed of [`cylinders_in`], whether its two rings of neighbours (taken or not) are
+/// flat enough that no ring it could grow has a curved scatter: every normal within δ of the
+/// seed's, sin²δ = 1e-5. For any subset of those triangles (the ring left once some are taken)
+/// the two smallest eigenvalues of the normalised scatter sum to 1 − λ_max ≤ 1 − n₀ᵀ M n₀ ≤
+/// sin²δ, below the 1e-4 a seed needs: the seed is passed over without building its ring.
+/// Checked in parallel; on a finely subdivided export most seeds are flat.
+fn flat_rings(
+    normals_areas: &[(Vector3<f64>, f64)],
+    neighbours: &[[u32; 3]],
+    patch: &[u32],
+    inside: &(impl Fn(u32) -> bool + Sync),
+) -> Vec<bool> {
+    let cos_delta = (1.0f64 - 1e-5).sqrt();
+    patch
+        .par_iter()
+        .map(|&seed| {
+            let n0 = normals_areas[seed as usize].0;
+            let near = |t: u32| normals_areas[t as usize].0.dot(&n0) >= cos_delta;
+            let next_to = |t: u32| {
+                neighbours[t as usize]
+                    .into_iter()
+                    .filter(|&s| s != u32::MAX && inside(s))
+            };
+            near(seed) && next_to(seed).all(|s| near(s) && next_to(s).all(near))
+        })
+        .collect()
 }
 
 /// Every facet whose corners lie on `cyl` (within [`GROW_DISTANCE_REL`]) and whose normal
@@ -248,6 +229,7 @@ pub(super) fn on_cylinder(
 ) -> Vec<u32> {
     let cos_tilt = GROW_TILT_DEG.to_radians().cos();
     (0..mesh.triangles.len() as u32)
+        .into_par_iter()
         .filter(|&t| {
             let c = mesh.corners(t as usize);
             let radial = |p: &Vector3<f64>| {
@@ -362,6 +344,7 @@ pub(super) fn describe_wall(
 /// Every bore of the surface (any arc), merged, largest wall area first.
 pub fn find_bores(mesh: &IndexedMesh) -> Vec<Bore> {
     let normals_areas: Vec<(Vector3<f64>, f64)> = (0..mesh.triangles.len())
+        .into_par_iter()
         .map(|t| {
             let [a, b, c] = mesh.corners(t);
             let n = (b - a).cross(&(c - a));
@@ -377,9 +360,6 @@ pub fn find_bores(mesh: &IndexedMesh) -> Vec<Bore> {
         })
         .collect();
     let normals: Vec<Vector3<f64>> = normals_areas.iter().map(|x| x.0).collect();
-    let mut walls: Vec<Wall> = Vec::new();
-    // whether a cylinder came out of splitting a smooth patch
-    let mut split = false;
     let (patches, neighbours) = smooth_patches(mesh, &normals);
     let mut patch_of = vec![0u32; mesh.triangles.len()];
     for (k, p) in patches.iter().enumerate() {
@@ -387,26 +367,35 @@ pub fn find_bores(mesh: &IndexedMesh) -> Vec<Bore> {
             patch_of[t as usize] = k as u32;
         }
     }
-    for (k, patch) in patches.into_iter().enumerate() {
-        if patch.len() < 4 {
-            continue;
-        }
-        match wall_of(mesh, &normals_areas, patch) {
-            Ok(w) => walls.push(w),
-            Err((patch, true)) => {
-                // a smooth patch of several surfaces (a bore whose rims are rounded into the
-                // faces): the cylinders in it, one by one
-                let inside = |t: u32| patch_of[t as usize] == k as u32;
-                for part in cylinders_in(mesh, &normals_areas, &neighbours, &patch, inside) {
-                    if let Ok(w) = wall_of(mesh, &normals_areas, part) {
-                        walls.push(w);
-                        split = true;
-                    }
-                }
+    // each patch's walls, and whether they came out of splitting it; patches side by side
+    let per_patch: Vec<(Vec<Wall>, bool)> = patches
+        .into_par_iter()
+        .enumerate()
+        .map(|(k, patch)| {
+            if patch.len() < 4 {
+                return (Vec::new(), false);
             }
-            Err(_) => {}
-        }
-    }
+            match wall_of(mesh, &normals_areas, patch) {
+                Ok(w) => (vec![w], false),
+                Err((patch, true)) => {
+                    // a smooth patch of several surfaces (a bore whose rims are rounded into the
+                    // faces): the cylinders in it, one by one
+                    let inside = |t: u32| patch_of[t as usize] == k as u32;
+                    let walls: Vec<Wall> =
+                        cylinders_in(mesh, &normals_areas, &neighbours, &patch, inside)
+                            .into_iter()
+                            .filter_map(|part| wall_of(mesh, &normals_areas, part).ok())
+                            .collect();
+                    let split = !walls.is_empty();
+                    (walls, split)
+                }
+                Err(_) => (Vec::new(), false),
+            }
+        })
+        .collect();
+    // whether a cylinder came out of splitting a smooth patch
+    let split = per_patch.iter().any(|(_, split)| *split);
+    let walls: Vec<Wall> = per_patch.into_iter().flat_map(|(w, _)| w).collect();
     // merge coaxial walls of equal radius
     let mut groups: Vec<Vec<usize>> = Vec::new();
     for (i, w) in walls.iter().enumerate() {
@@ -424,7 +413,7 @@ pub fn find_bores(mesh: &IndexedMesh) -> Vec<Bore> {
         }
     }
     let mut bores: Vec<Bore> = groups
-        .iter()
+        .par_iter()
         .filter_map(|g| {
             let triangles: Vec<u32> = g
                 .iter()
