@@ -253,7 +253,7 @@ def cmd_project(args) -> dict:
             d[mids[sel, k]] = 0.5 * (d[tets[sel, a]] + d[tets[sel, b]])
         return d
 
-    # as rodstudy's curving (src/fem/smooth.rs): halve the moves of the boundary nodes of an element
+    # as rodstudy's curving (src/rod/smooth.rs): halve the moves of the boundary nodes of an element
     # whose det J falls below 0.3 of its straight value, up to eight times, then drop them
     damp = np.ones(len(pts))
     straight = 6.0 * corner_volumes(pts, touched)

@@ -5,7 +5,7 @@
 //! memory (VmHWM) is its own and the wall times are comparable.
 //!
 //! The reference of each case is the adaptive sequence's last peak extrapolated (Richardson, as
-//! `fem::adapt` estimates it): the best value the program has; its own estimated error is in the
+//! `rod::adapt` estimates it): the best value the program has; its own estimated error is in the
 //! table. Writes `convergence.md`, `convergence.csv`, `convergence.json` and `convergence.svg`
 //! (error against wall time, log–log) into the output folder.
 
