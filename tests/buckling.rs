@@ -200,7 +200,9 @@ fn the_buckling_beside_the_geometry_check_is_the_one_after_it() {
     let load = 7000.0;
     let out = stages::fem::fem_and_buckling(
         &design,
-        load,
+        &stages::fem::FemLoads::of_design(&design, &config)
+            .unwrap()
+            .with_force(load),
         &config,
         dir.path(),
         &MeshMode::Fixed(8.0),
@@ -221,7 +223,9 @@ fn the_buckling_beside_the_geometry_check_is_the_one_after_it() {
     // without a load asked for, none is run
     let none = stages::fem::fem_and_buckling(
         &design,
-        load,
+        &stages::fem::FemLoads::of_design(&design, &config)
+            .unwrap()
+            .with_force(load),
         &config,
         &dir.path().join("again"),
         &MeshMode::Fixed(8.0),

@@ -55,9 +55,17 @@ fn fem(dir: &Path, name: &str, config: &StudyConfig, mode: &MeshMode) -> DesignF
     let work = dir.join(format!("work-{name}"));
     let design = stages::mass::load(&dir.join(format!("{name}.stl")))
         .unwrap_or_else(|e| panic!("{name}: {e:#}"));
-    stages::fem::fem(&design, 7500.0, config, &work, mode)
-        .unwrap_or_else(|e| panic!("{name}: {e:#}"))
-        .record
+    stages::fem::fem(
+        &design,
+        &stages::fem::FemLoads::of_design(&design, config)
+            .unwrap()
+            .with_force(7500.0),
+        config,
+        &work,
+        mode,
+    )
+    .unwrap_or_else(|e| panic!("{name}: {e:#}"))
+    .record
 }
 
 /// Stage 3 of the STL `stl` under `force` [N], refined adaptively to the configuration's target.
@@ -69,9 +77,17 @@ fn adaptive_record(
 ) -> rodstudy::stages::records::DesignFem {
     let design = stages::mass::load(stl).unwrap();
     let mode = MeshMode::Adaptive(AdaptiveMeshing::new(&config.fem, config.fem.target_error));
-    stages::fem::fem(&design, force, config, work, &mode)
-        .unwrap()
-        .record
+    stages::fem::fem(
+        &design,
+        &stages::fem::FemLoads::of_design(&design, config)
+            .unwrap()
+            .with_force(force),
+        config,
+        work,
+        &mode,
+    )
+    .unwrap()
+    .record
 }
 
 #[test]
@@ -332,9 +348,12 @@ fn the_geometry_error_of_a_coarse_cad_export_is_estimated_honestly() {
         step.to_str().unwrap(),
         exact.to_str().unwrap(),
     ]);
+    let brep_design = stages::mass::load(&stl).unwrap();
     let on_brep = stages::fem::fem(
-        &stages::mass::load(&stl).unwrap(),
-        force,
+        &brep_design,
+        &stages::fem::FemLoads::of_design(&brep_design, &config)
+            .unwrap()
+            .with_force(force),
         &config,
         &dir.path().join("work-exact"),
         &MeshMode::User(exact),

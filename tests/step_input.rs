@@ -415,7 +415,9 @@ fn curved_tet10_on_the_step_fillet_rod() {
     let design = stages::mass::load(&step).unwrap();
     let r = stages::fem::fem(
         &design,
-        data["force_n"].as_f64().unwrap(),
+        &stages::fem::FemLoads::of_design(&design, &config)
+            .unwrap()
+            .with_force(data["force_n"].as_f64().unwrap()),
         &config,
         &dir.path().join("work"),
         &MeshMode::Adaptive(AdaptiveMeshing::new(&config.fem, 0.03)),
@@ -461,7 +463,9 @@ fn curved_tet10_on_the_step_fillet_rod() {
     let design = stages::mass::load(&stl).unwrap();
     let s = stages::fem::fem(
         &design,
-        data["force_n"].as_f64().unwrap(),
+        &stages::fem::FemLoads::of_design(&design, &config)
+            .unwrap()
+            .with_force(data["force_n"].as_f64().unwrap()),
         &config,
         &dir.path().join("work-stl"),
         &MeshMode::Adaptive(AdaptiveMeshing::new(&config.fem, 0.03)),
@@ -525,9 +529,17 @@ fn a_small_fillet_cut_into_45_degree_facets_is_refined_not_excluded() {
     let adaptive = MeshMode::Adaptive(AdaptiveMeshing::new(&config.fem, 0.03));
     let run = |name: &str, mode: &MeshMode| {
         let design = stages::mass::load(&dir.path().join(format!("{name}.stl"))).unwrap();
-        stages::fem::fem(&design, 7500.0, &config, &dir.path().join(name), mode)
-            .unwrap_or_else(|e| panic!("{name}: {e:#}"))
-            .record
+        stages::fem::fem(
+            &design,
+            &stages::fem::FemLoads::of_design(&design, &config)
+                .unwrap()
+                .with_force(7500.0),
+            &config,
+            &dir.path().join(name),
+            mode,
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e:#}"))
+        .record
     };
     let chord = run("stepped_chord", &adaptive);
     let fx = &chord.fem.cases["fx"];

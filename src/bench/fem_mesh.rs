@@ -283,8 +283,14 @@ pub fn bench_fem_mesh(
     phase("draw the pictures (2 SVG)", t, true);
 
     // the stage itself moves the mesh as above
-    let stage =
-        stages::fem::fem_user_mesh(&design, force_n, &config, work.path(), mesh_file, false)?;
+    let stage = stages::fem::fem_user_mesh(
+        &design,
+        &stages::fem::FemLoads::of_design(&design, &config)?.with_force(force_n),
+        &config,
+        work.path(),
+        mesh_file,
+        false,
+    )?;
     if !same_mesh(&stage.mesh.mesh, &mesh) {
         bail!("the benchmark moved the mesh differently from the stage");
     }

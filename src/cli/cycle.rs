@@ -57,7 +57,7 @@ pub fn run(args: CycleArgs) -> Result<i32> {
     )?;
     let mut f = stages::fem::fem(
         &design,
-        dynamics.peak_pin_force_n,
+        &stages::fem::FemLoads::from_records(&mass, &dynamics, &config),
         &config,
         &args.out.join("mesh"),
         &mode,

@@ -3,8 +3,8 @@
 
 use super::mesh_args::MeshArgs;
 use crate::config::StudyConfig;
-use crate::mechanism::Method;
 use crate::stages;
+use crate::stages::fem::FemLoads;
 use crate::stages::fem::MeshMode;
 use crate::stages::records::{DesignFem, LoadedDesign};
 use anyhow::{Result, bail};
@@ -56,32 +56,28 @@ pub struct FemArgs {
 
 /// The design's peak pin force (stage 2), the load of both cases unless `--force` gives one.
 pub(crate) fn peak_force(design: &LoadedDesign, config: &StudyConfig) -> Result<f64> {
-    let mass = stages::mass::mass(design)?;
-    let (dynamics, _) = stages::dynamics::dynamics_with(
-        &mass,
-        &config.driven_scene(),
-        config.driven.gravity,
-        &config.engine,
-        Method::ClosedForm,
-    )?;
-    Ok(dynamics.peak_pin_force_n)
+    Ok(FemLoads::of_design(design, config)?.force_n)
 }
 
 pub fn run(args: FemArgs) -> Result<i32> {
     let config = StudyConfig::load(args.config.as_deref())?;
     let mode = args.mesh.mode(&config)?;
     let design = stages::mass::load(&args.design)?;
-    let force = match args.force {
-        Some(f) if f.is_finite() && f > 0.0 => f,
+    let design_loads = FemLoads::of_design(&design, &config)?;
+    let loads = match args.force {
+        Some(f) if f.is_finite() && f > 0.0 => design_loads.with_force(f),
         Some(f) => bail!("--force must be a positive number of newtons, got {f}"),
         None => {
-            let f = peak_force(&design, &config)?;
-            eprintln!("load: the design's peak pin force, {f:.1} N");
-            f
+            eprintln!(
+                "load: the design's peak pin force, {:.1} N",
+                design_loads.force_n
+            );
+            design_loads
         }
     };
+    let force = loads.force_n;
     if let Some(sizes) = &args.refine {
-        return refine(&args, &design, &config, force, sizes);
+        return refine(&args, &design, &config, &loads, sizes);
     }
     if args.convergence {
         let target = match &mode {
@@ -120,11 +116,11 @@ pub fn run(args: FemArgs) -> Result<i32> {
         (true, _) => None,
         (false, Some(f)) => Some(f),
         (false, None) if engine => None,
-        (false, None) => Some(stages::fem::buckling_load(&design, &config)?),
+        (false, None) => Some(loads.compression_n),
     };
     let mut outcome = stages::fem::fem_and_buckling(
         &design,
-        force,
+        &loads,
         &config,
         &args.out.join("mesh"),
         &mode,
@@ -337,11 +333,12 @@ fn refine(
     args: &FemArgs,
     design: &LoadedDesign,
     config: &StudyConfig,
-    force: f64,
+    loads: &FemLoads,
     sizes: &[f64],
 ) -> Result<i32> {
+    let force = loads.force_n;
     let study =
-        stages::fem::fem_refinement(design, force, config, &args.out.join("refinement"), sizes)?;
+        stages::fem::fem_refinement(design, loads, config, &args.out.join("refinement"), sizes)?;
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&study)?);
         return Ok(0);

@@ -280,7 +280,7 @@ fn study_one(
             let context = || format!("{}: FEM", stl.display());
             let mut f = stages::fem::fem(
                 &design,
-                dynamics.peak_pin_force_n,
+                &stages::fem::FemLoads::from_records(&mass, &dynamics, config),
                 config,
                 &work,
                 &MeshMode::from_config(config),

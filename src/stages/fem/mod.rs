@@ -26,6 +26,7 @@ use crate::config::{FemConfig, StudyConfig};
 use crate::fem::buckling::{BucklingMode, BucklingOptions, BucklingSolution};
 use crate::fem::statics::FactorisedSystem;
 use crate::fem::{Material, TetMesh};
+use crate::geometry::design::DesignMass;
 use crate::rod::buckling::rod_buckling;
 use crate::rod::solve::RodSolution;
 use crate::rod::{BoreSpec, RodOptions};
@@ -105,16 +106,16 @@ pub struct BucklingRun {
     pub result: Result<BucklingSolution>,
 }
 
-/// Stage 3 of a loaded design under `force_n` in the mode asked for; gmsh's files go under
+/// Stage 3 of a loaded design under `loads` in the mode asked for; gmsh's files go under
 /// `work_dir`.
 pub fn fem(
     design: &LoadedDesign,
-    force_n: f64,
+    loads: &FemLoads,
     config: &StudyConfig,
     work_dir: &Path,
     mode: &MeshMode,
 ) -> Result<FemOutcome> {
-    fem_and_buckling(design, force_n, config, work_dir, mode, false, None)
+    fem_and_buckling(design, loads, config, work_dir, mode, false, None)
 }
 
 /// [`fem`]; `keep_system`: the outcome keeps the factorised K of the final mesh
@@ -126,7 +127,7 @@ pub fn fem(
 /// loop 0.1–1.0 s less on the five designs; docs/fem.md).
 pub fn fem_and_buckling(
     design: &LoadedDesign,
-    force_n: f64,
+    loads: &FemLoads,
     config: &StudyConfig,
     work_dir: &Path,
     mode: &MeshMode,
@@ -134,23 +135,19 @@ pub fn fem_and_buckling(
     buckling_n: Option<f64>,
 ) -> Result<FemOutcome> {
     let engine = config.engine.pressure_trace.is_some();
-    let engine_n = if engine {
-        Some(buckling_load(design, config)?)
-    } else {
-        None
-    };
+    let engine_n = engine.then_some(loads.compression_n);
     // one analysis beside the geometry check: the engine's, else the one asked for
     let beside = engine_n.or(buckling_n);
     let keep = keep_system || beside.is_some();
     let mut outcome = match mode {
         MeshMode::Fixed(size_mm) => {
-            fem_fixed(design, force_n, config, work_dir, *size_mm, keep, beside)
+            fem_fixed(design, loads, config, work_dir, *size_mm, keep, beside)
                 .map_err(|e| crossing_facets_said(design, e))
         }
-        MeshMode::Adaptive(a) => fem_adaptive(design, force_n, config, work_dir, a, keep, beside)
+        MeshMode::Adaptive(a) => fem_adaptive(design, loads, config, work_dir, a, keep, beside)
             .map_err(|e| crossing_facets_said(design, e)),
         MeshMode::User(file) => {
-            let mut outcome = fem_user_mesh(design, force_n, config, work_dir, file, keep)?;
+            let mut outcome = fem_user_mesh(design, loads, config, work_dir, file, keep)?;
             outcome.buckling_run = beside.map(|n| buckling_run(&outcome, config, n));
             Ok(outcome)
         }
@@ -200,44 +197,65 @@ fn crossing_facets_said(design: &LoadedDesign, e: anyhow::Error) -> anyhow::Erro
     ))
 }
 
-/// The engine's loads of a design (with a pressure trace): stage 2's record on the configured
-/// engine (closed form), whose peak compression is the buckling case's load and whose largest
-/// pin force across the rod is the F_y case's magnitude. `None` without a trace.
-pub fn engine_loads(design: &LoadedDesign, config: &StudyConfig) -> Result<Option<DesignDynamics>> {
-    if config.engine.pressure_trace.is_none() {
-        return Ok(None);
-    }
-    let mass = super::mass::mass(design)?;
-    let (dynamics, _) = super::dynamics::dynamics_with(
-        &mass,
-        &config.driven_scene(),
-        config.driven.gravity,
-        &config.engine,
-        crate::mechanism::Method::ClosedForm,
-    )?;
-    Ok(Some(dynamics))
+/// What stage 3 takes from the records of stages 1 and 2: the forces of its load cases and of its
+/// buckling case, and the arcs of the bores.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FemLoads {
+    /// The pin force: the F_x case's magnitude (stage 2's peak pin force, or `fem --force`), N.
+    pub force_n: f64,
+    /// With a pressure trace, the largest pin force across the rod over the cycle: the F_y case's
+    /// magnitude (`None`: the pin force, the thesis' setting), N.
+    pub transverse_n: Option<f64>,
+    /// The buckling case's compression: with a pressure trace the peak compression along A→B,
+    /// else the peak pin force, N.
+    pub compression_n: f64,
+    /// The arcs of the crank-pin bore A and the piston-pin bore B (a partial bore, a big end
+    /// without its cap, is loaded or fixed on the arc that exists), degrees.
+    pub bore_arcs_deg: [f64; 2],
 }
 
-/// The load of the buckling case of a design: with a pressure trace its peak compression along
-/// A→B (`peak_compression_n` of stage 2), else its peak pin force (the F_x case's magnitude).
-pub fn buckling_load(design: &LoadedDesign, config: &StudyConfig) -> Result<f64> {
-    let dynamics = match engine_loads(design, config)? {
-        Some(d) => d,
-        None => {
-            let mass = super::mass::mass(design)?;
-            super::dynamics::dynamics_with(
-                &mass,
-                &config.driven_scene(),
-                config.driven.gravity,
-                &config.engine,
-                crate::mechanism::Method::ClosedForm,
-            )?
-            .0
+impl FemLoads {
+    /// The loads of stage 3 from the records of stage 1 (`mass`) and stage 2 (`dynamics`, on the
+    /// configured engine).
+    pub fn from_records(
+        mass: &DesignMass,
+        dynamics: &DesignDynamics,
+        config: &StudyConfig,
+    ) -> Self {
+        let engine = config.engine.pressure_trace.is_some();
+        FemLoads {
+            force_n: dynamics.peak_pin_force_n,
+            transverse_n: if engine {
+                dynamics.peak_transverse_n
+            } else {
+                None
+            },
+            compression_n: dynamics
+                .peak_compression_n
+                .unwrap_or(dynamics.peak_pin_force_n),
+            bore_arcs_deg: [mass.pins.crank_bore_arc_deg, mass.pins.piston_bore_arc_deg],
         }
-    };
-    Ok(dynamics
-        .peak_compression_n
-        .unwrap_or(dynamics.peak_pin_force_n))
+    }
+
+    /// The loads of a design whose stages 1 and 2 have not run (a command on one design, a test):
+    /// they run here (stage 2 in closed form on the configured scene and engine, as the study runs
+    /// it).
+    pub fn of_design(design: &LoadedDesign, config: &StudyConfig) -> Result<Self> {
+        let mass = super::mass::mass(design)?;
+        let (dynamics, _) = super::dynamics::dynamics_with(
+            &mass,
+            &config.driven_scene(),
+            config.driven.gravity,
+            &config.engine,
+            crate::mechanism::Method::ClosedForm,
+        )?;
+        Ok(Self::from_records(&mass, &dynamics, config))
+    }
+
+    /// These loads with the pin force `force_n` (N) instead (`fem --force`).
+    pub fn with_force(self, force_n: f64) -> Self {
+        FemLoads { force_n, ..self }
+    }
 }
 
 /// [`buckling`] on the outcome's mesh and its kept factorisation, not yet applied.

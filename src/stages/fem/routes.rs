@@ -28,14 +28,15 @@ fn joined(fallbacks: &[String]) -> Option<String> {
 /// Stage 3 on one gmsh mesh of uniform size `size_mm` (the thesis' setting is 5 mm).
 pub fn fem_fixed(
     design: &LoadedDesign,
-    force_n: f64,
+    loads: &FemLoads,
     config: &StudyConfig,
     work_dir: &Path,
     size_mm: f64,
     keep_system: bool,
     buckling_n: Option<f64>,
 ) -> Result<FemOutcome> {
-    let setup = Setup::new(design, config, true, keep_system)?;
+    let setup = Setup::new(design, loads, config, true, keep_system)?;
+    let force_n = loads.force_n;
     setup.check_uniform_size(design, size_mm, "size (`--size`, `fem.mesh_size_mm`)")?;
     let mut mesher = setup.mesher(work_dir)?;
     let meshed = mesher
@@ -74,14 +75,15 @@ pub fn fem_fixed(
 /// the target ([`crate::rod::adapt`]), sizes floored at the STL's local facet spacing.
 pub fn fem_adaptive(
     design: &LoadedDesign,
-    force_n: f64,
+    loads: &FemLoads,
     config: &StudyConfig,
     work_dir: &Path,
     settings: &AdaptiveMeshing,
     keep_system: bool,
     buckling_n: Option<f64>,
 ) -> Result<FemOutcome> {
-    let setup = Setup::new(design, config, true, keep_system)?;
+    let setup = Setup::new(design, loads, config, true, keep_system)?;
+    let force_n = loads.force_n;
     setup.check_uniform_size(
         design,
         settings.initial_size_mm,
@@ -183,7 +185,7 @@ pub fn fem_adaptive(
 /// the rod frame.
 pub fn fem_user_mesh(
     design: &LoadedDesign,
-    force_n: f64,
+    loads: &FemLoads,
     config: &StudyConfig,
     work_dir: &Path,
     file: &Path,
@@ -196,7 +198,7 @@ pub fn fem_user_mesh(
             let start = std::time::Instant::now();
             read_volume_mesh(file, "mm", work_dir).map(|(m, _)| (m, start.elapsed()))
         });
-        let setup = Setup::without_edges(design, config, false, keep_system);
+        let setup = Setup::without_edges(design, loads, config, false, keep_system);
         let read = reading
             .join()
             .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
@@ -234,7 +236,15 @@ pub fn fem_user_mesh(
     // the surface's sharp edges matter only to the stresses' post-processing: worked out while K
     // is factorised (on one thread)
     let (solved, edges) = rayon::join(
-        || solve_rod_static(&mesh, &setup.material, &setup.bores, force_n, &setup.rod),
+        || {
+            solve_rod_static(
+                &mesh,
+                &setup.material,
+                &setup.bores,
+                loads.force_n,
+                &setup.rod,
+            )
+        },
         || setup.surface_edges(),
     );
     setup.set_edges(edges);
@@ -255,7 +265,7 @@ pub fn fem_user_mesh(
         fallback: None,
         curved_elements_straightened: None,
     };
-    Ok(setup.outcome(force_n, config, summary, mesh, solution))
+    Ok(setup.outcome(loads.force_n, config, summary, mesh, solution))
 }
 
 /// How far a given mesh's volume may lie from the design's (relative): a straight-sided tet10
@@ -323,14 +333,15 @@ fn check_mesh_is_the_designs(mesh: &TetMesh, surface: &RodFrameSurface) -> Resul
 /// bore from the configuration ([`crate::rod::refinement`]).
 pub fn fem_refinement(
     design: &LoadedDesign,
-    force_n: f64,
+    loads: &FemLoads,
     config: &StudyConfig,
     work_dir: &Path,
     sizes_mm: &[f64],
 ) -> Result<RefinementStudy> {
     // meshed in the rod frame, mm, as stage 3 meshes (any units and pose); the whole rod, whose
     // uniform meshes the study compares
-    let mut setup = Setup::new(design, config, true, false)?;
+    let mut setup = Setup::new(design, loads, config, true, false)?;
+    let force_n = loads.force_n;
     setup.half = None;
     setup.rod.mirror_plane_z_m = None;
     for &size in sizes_mm {

@@ -48,9 +48,10 @@ impl Setup {
     /// them out while K is factorised, [`fem_user_mesh`]). `for_gmsh`: the surface is what gmsh
     /// will mesh (simplified); else a given mesh is solved and the surface only tells the sharp
     /// re-entrant edges. With a pressure trace the F_y case carries the largest pin force across
-    /// the rod over the engine's cycle ([`engine_loads`]).
+    /// the rod over the engine's cycle ([`FemLoads::transverse_n`]).
     pub(super) fn without_edges(
         design: &LoadedDesign,
+        loads: &FemLoads,
         config: &StudyConfig,
         for_gmsh: bool,
         keep_system: bool,
@@ -65,9 +66,6 @@ impl Setup {
                 gap * 1e3
             );
         }
-        let fy_force_n = engine_loads(design, config)
-            .with_context(|| context.clone())?
-            .and_then(|d| d.peak_transverse_n);
         let surface = rod_frame_surface(design, for_gmsh);
         let half = if for_gmsh && design.format.step().is_none() {
             half_surface(&surface, config.fem.symmetry)
@@ -78,7 +76,7 @@ impl Setup {
             mirror_plane_z_m: half.as_ref().map(|h| h.plane_z_mm * 1e-3),
             fixed_band_m: Some(config.fem.fixed_band_mm * 1e-3),
             singular_band_m: Some(config.fem.singular_band_mm * 1e-3),
-            fy_force_n,
+            fy_force_n: loads.transverse_n,
             exact_geometry: design.format.step().is_some(),
             // the STL route keeps the last solve's system: the geometry check reuses its symbolic
             // analysis
@@ -97,10 +95,7 @@ impl Setup {
         });
         // a partial bore (a big end without its cap) is loaded or fixed on the arc that exists
         let mut bores = surface.bores();
-        if let Ok(m) = crate::geometry::design::rod_mass(design) {
-            bores.loaded_arc_deg = m.pins.crank_bore_arc_deg;
-            bores.fixed_arc_deg = m.pins.piston_bore_arc_deg;
-        }
+        [bores.loaded_arc_deg, bores.fixed_arc_deg] = loads.bore_arcs_deg;
         bores.bore_load = config.fem.bore_load;
         Ok(Setup {
             step,
@@ -119,11 +114,12 @@ impl Setup {
     /// [`Setup::without_edges`] with the surface's edges ([`Setup::set_edges`]).
     pub(super) fn new(
         design: &LoadedDesign,
+        loads: &FemLoads,
         config: &StudyConfig,
         for_gmsh: bool,
         keep_system: bool,
     ) -> Result<Self> {
-        let mut setup = Self::without_edges(design, config, for_gmsh, keep_system)?;
+        let mut setup = Self::without_edges(design, loads, config, for_gmsh, keep_system)?;
         let edges = setup.surface_edges();
         setup.set_edges(edges);
         Ok(setup)
