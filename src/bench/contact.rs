@@ -5,17 +5,23 @@
 
 use std::time::Duration;
 
+use serde::Serialize;
+
 use super::median_time;
 use crate::fem::boundary::boundary_faces;
-use crate::fem::contact::{ContactProblem, ContactTolerances, Cylinder, PinMotion, solve_contact};
+use crate::fem::contact::{
+    ContactProblem, ContactTimings, ContactTolerances, Cylinder, PinMotion, solve_contact,
+};
 use crate::fem::error::Result;
 use crate::fem::load::uniform_traction_with_resultant;
 use crate::fem::mesh::structured::{TwoEyePlate, two_eye_plate};
 use crate::fem::{Material, QuadratureChoice, StaticProblem, solve_static};
 
 /// The timings of [`bench_contact`].
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Serialize)]
 pub struct ContactBench {
+    /// Divisions per bore quarter of the plate.
+    pub n_side: usize,
     /// Equations of the mesh.
     pub dofs: usize,
     /// Median wall time of the linear solve.
@@ -24,10 +30,15 @@ pub struct ContactBench {
     pub contact: Duration,
     /// contact / linear.
     pub ratio: f64,
-    /// Contact rows and the compliance columns the active set needed.
+    /// Contact rows (pressure nodes).
     pub rows: usize,
-    /// Columns computed.
+    /// Columns of the contact compliance computed.
     pub columns: usize,
+    /// Active-set iterations.
+    pub iterations: usize,
+    /// The phases of the last contact solve.
+    #[serde(skip)]
+    pub phases: ContactTimings,
 }
 
 /// Times both solves `repeats` times on the plate with `n_side` divisions per bore quarter.
@@ -104,12 +115,15 @@ pub fn bench_contact(n_side: usize, repeats: usize) -> Result<ContactBench> {
     let (t_con, con) = median_time(repeats, || solve_contact(&contact));
     let con = con?;
     Ok(ContactBench {
+        n_side,
         dofs,
         linear: t_lin,
         contact: t_con,
         ratio: t_con.as_secs_f64() / t_lin.as_secs_f64(),
         rows: con.rows,
         columns: con.columns,
+        iterations: con.iterations,
+        phases: con.timings,
     })
 }
 
