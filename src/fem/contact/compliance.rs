@@ -16,9 +16,11 @@
 //! e.g. Wriggers, *Computational Contact Mechanics*, 2nd ed., §6.3.4, condensation on the
 //! contact DOFs). The displacement solves use the same factor: b' = Tᵀ b, u = T v.
 //!
-//! A wall node with a prescribed DOF (its nodal frame would mix a prescribed and a free
-//! component) or on two walls keeps the columns solved one by one with the factor of K
-//! ([`Compliance::Solves`]).
+//! A wall node prescribed in its axial component only (the axis along x, y or z: plane strain,
+//! a symmetry plane across the axis) keeps the frame exact, the prescribed component being the
+//! frame's axial one. Any other prescribed DOF at a wall node (its frame would mix a prescribed
+//! and a free component), or a node on two walls, keeps the columns solved one by one with the
+//! factor of K ([`Compliance::Solves`]).
 
 use faer::Par;
 use faer::linalg::triangular_solve::{
@@ -37,42 +39,71 @@ const BLOCK: usize = 32;
 /// The nodal frames of the wall nodes, on the equations.
 #[derive(Clone, Debug)]
 pub struct NodalFrames {
-    /// Per equation: (index of its node's frame, component 0..3) for the wall nodes.
+    /// Per equation: (index of its node's frame, Cartesian component) for the wall nodes.
     at: Vec<Option<(usize, usize)>>,
-    /// Per frame: the equations of (x, y, z) and R (columns e, â × e, â).
-    frames: Vec<([usize; 3], [[f64; 3]; 3])>,
+    /// Whether an equation holds a radial component.
+    is_radial: Vec<bool>,
+    /// Per frame: the equations of the Cartesian components (x, y, z), the equations holding
+    /// the frame's components (radial, circumferential, axial), and R (columns e, â × e, â).
+    frames: Vec<Frame>,
 }
 
+type Frame = ([Option<usize>; 3], [Option<usize>; 3], [[f64; 3]; 3]);
+
 impl NodalFrames {
-    /// The frames of the walls' nodes (per row, in row order), or `None` when a wall node has
-    /// a prescribed DOF or lies on two walls.
+    /// The frames of the walls' nodes (per row, in row order), or `None` when a wall node lies
+    /// on two walls or has a prescribed DOF other than its axial one on an axis along x, y or z
+    /// (the plane-strain and symmetry-plane supports keep the frame exact: the prescribed
+    /// component is the frame's axial one).
     pub fn new(walls: &[Wall], dofs: &DofMap) -> Option<NodalFrames> {
         let mut at = vec![None; dofs.n_eq()];
+        let mut is_radial = vec![false; dofs.n_eq()];
         let mut frames = Vec::new();
         for w in walls {
             for (a, &nd) in w.nodes.iter().enumerate() {
-                let mut eqs = [0; 3];
-                for (j, q) in eqs.iter_mut().enumerate() {
-                    *q = dofs.eq(3 * nd + j)?;
-                }
-                if at[eqs[0]].is_some() {
-                    return None;
-                }
+                let cart: [Option<usize>; 3] = std::array::from_fn(|j| dofs.eq(3 * nd + j));
                 let (e, t) = (w.e[a], w.axis);
-                let s = cross(t, e);
-                let r = std::array::from_fn(|i| [e[i], s[i], t[i]]);
-                for (j, &q) in eqs.iter().enumerate() {
+                let slots = match cart.iter().filter(|q| q.is_none()).count() {
+                    0 => cart,
+                    1 => {
+                        let j = cart.iter().position(|q| q.is_none())?;
+                        if t[j].abs() < 1.0 - 1e-12 {
+                            return None;
+                        }
+                        let mut free = cart.iter().flatten().copied();
+                        [free.next(), free.next(), None]
+                    }
+                    _ => return None,
+                };
+                for (j, &q) in cart
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(j, q)| q.as_ref().map(|q| (j, q)))
+                {
+                    if at[q].is_some() {
+                        return None;
+                    }
                     at[q] = Some((frames.len(), j));
                 }
-                frames.push((eqs, r));
+                is_radial[slots[0]?] = true;
+                let s = cross(t, e);
+                let r = std::array::from_fn(|i| [e[i], s[i], t[i]]);
+                frames.push((cart, slots, r));
             }
         }
-        Some(NodalFrames { at, frames })
+        Some(NodalFrames {
+            at,
+            is_radial,
+            frames,
+        })
     }
 
     /// The radial equation of each frame (row order).
     pub fn radial(&self) -> Vec<usize> {
-        self.frames.iter().map(|f| f.0[0]).collect()
+        self.frames
+            .iter()
+            .map(|f| f.1[0].expect("a radial slot"))
+            .collect()
     }
 
     /// `order` (`order[new] = old`) with the radial equations moved last, in row order.
@@ -80,7 +111,7 @@ impl NodalFrames {
         let mut out: Vec<usize> = order
             .iter()
             .copied()
-            .filter(|&q| !matches!(self.at[q], Some((_, 0))))
+            .filter(|&q| !self.is_radial[q])
             .collect();
         out.extend(self.radial());
         out
@@ -97,12 +128,14 @@ impl NodalFrames {
                 }
             }
         }
-        // T's entries of row p: (p', T_pp')
+        // T's entries of row p (u_p = Σ T_pp' v_p'): (p', T_pp')
         let t_row = |p: usize| -> Vec<(usize, f64)> {
             match self.at[p] {
                 Some((f, alpha)) => {
-                    let (eqs, r) = &self.frames[f];
-                    (0..3).map(|beta| (eqs[beta], r[alpha][beta])).collect()
+                    let (_, slots, r) = &self.frames[f];
+                    (0..3)
+                        .filter_map(|beta| slots[beta].map(|q| (q, r[alpha][beta])))
+                        .collect()
                 }
                 None => vec![(p, 1.0)],
             }
@@ -140,12 +173,19 @@ impl NodalFrames {
 
     /// x ↦ Tᵀ x (`to_nodal`) or x ↦ T x, in place, on a vector of equations.
     pub fn rotate(&self, x: &mut [f64], to_nodal: bool) {
-        for (eqs, r) in &self.frames {
-            let u = eqs.map(|q| x[q]);
+        for (cart, slots, r) in &self.frames {
+            let (from, to) = if to_nodal {
+                (cart, slots)
+            } else {
+                (slots, cart)
+            };
+            let u = from.map(|q| q.map_or(0.0, |q| x[q]));
             for i in 0..3 {
-                x[eqs[i]] = (0..3)
-                    .map(|j| if to_nodal { r[j][i] } else { r[i][j] } * u[j])
-                    .sum();
+                if let Some(q) = to[i] {
+                    x[q] = (0..3)
+                        .map(|j| if to_nodal { r[j][i] } else { r[i][j] } * u[j])
+                        .sum();
+                }
             }
         }
     }
