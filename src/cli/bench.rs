@@ -76,6 +76,15 @@ pub enum BenchCommand {
         /// Repeats per solve (at least 1); the median is reported.
         #[arg(long, default_value_t = 3, value_parser = at_least_one)]
         repeats: usize,
+        /// A design's rod instead of the plate: its STL, with `--mesh`.
+        #[arg(long, requires = "mesh")]
+        design: Option<PathBuf>,
+        /// The rod's mesh in the rod frame, millimetres (the mesher's `mesh/fixed/rod.msh`).
+        #[arg(long, requires = "design")]
+        mesh: Option<PathBuf>,
+        /// The pin force along AB with `--design`, N.
+        #[arg(long, default_value_t = 20e3)]
+        force: f64,
         #[arg(long)]
         json: bool,
     },
@@ -138,9 +147,37 @@ pub fn run(command: BenchCommand) -> Result<i32> {
             ..
         } => bench_fem(designs, size.unwrap_or(5.0), force, json),
         BenchCommand::Contact {
+            design: Some(design),
+            mesh: Some(mesh),
+            repeats,
+            force,
+            json,
+            ..
+        } => {
+            let b = crate::bench::contact::bench_contact_rod(&design, &mesh, force, repeats)?;
+            if json {
+                outln!("{}", serde_json::to_string_pretty(&b)?);
+            } else {
+                outln!(
+                    "{}: {} nodes, static cases {:.2} s, contact (F_x, 10 µm) {:.2} s, ratio \
+                     {:.2}; {} rows, {} columns; {:?}",
+                    design.display(),
+                    b.nodes,
+                    b.linear.as_secs_f64(),
+                    b.contact.as_secs_f64(),
+                    b.ratio,
+                    b.rows,
+                    b.columns,
+                    b.phases
+                );
+            }
+            Ok(0)
+        }
+        BenchCommand::Contact {
             n_side,
             repeats,
             json,
+            ..
         } => bench_contact(&n_side, repeats, json),
         BenchCommand::Dynamics {
             design,

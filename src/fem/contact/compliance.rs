@@ -122,9 +122,10 @@ impl NodalFrames {
         let mut values = k.values.clone();
         let touched = |p: usize| self.at[p].is_some();
         for q in 0..k.n {
-            for i in k.col_ptr[q]..k.col_ptr[q + 1] {
-                if touched(k.row_idx[i]) || touched(q) {
-                    values[i] = 0.0;
+            let range = k.col_ptr[q]..k.col_ptr[q + 1];
+            for (v, &p) in values[range.clone()].iter_mut().zip(&k.row_idx[range]) {
+                if touched(p) || touched(q) {
+                    *v = 0.0;
                 }
             }
         }
