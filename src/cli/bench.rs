@@ -1,6 +1,6 @@
 //! `rodstudy bench mass [--triangles N] [--repeats R] [--json]`, `bench fem [DESIGN...] [--size MM]
 //! [--force N] [--json]`, `bench fem DESIGN --mesh FILE [--force N] [--repeats K] [--ccx] [--json]`,
-//! `bench dynamics [DESIGN]`
+//! `bench dynamics [DESIGN]`, `bench contact [--n-side N...] [--repeats R] [--json]`
 
 use crate::bench::mass::bench_mass;
 use crate::mechanism::{DrivenScene, MechanismParams, RodInertia, bench_driven};
@@ -66,6 +66,28 @@ pub enum BenchCommand {
         #[arg(long)]
         json: bool,
     },
+    /// Contact against the linear solve of the same mesh, in the same process: the two-eye
+    /// plate, pin A pushed along AB with a clearance, pin B fixed, against a uniform traction on
+    /// bore A with bore B clamped.
+    Contact {
+        /// Divisions per bore quarter (one plate per value; 6 ≈ 26 kDOF, 10 ≈ 94 kDOF).
+        #[arg(long = "n-side", default_values_t = [6, 10], value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(2..))]
+        n_side: Vec<usize>,
+        /// Repeats per solve (at least 1); the median is reported.
+        #[arg(long, default_value_t = 3, value_parser = at_least_one)]
+        repeats: usize,
+        /// A design's rod instead of the plate: its STL, with `--mesh`.
+        #[arg(long, requires = "mesh")]
+        design: Option<PathBuf>,
+        /// The rod's mesh in the rod frame, millimetres (the mesher's `mesh/fixed/rod.msh`).
+        #[arg(long, requires = "design")]
+        mesh: Option<PathBuf>,
+        /// The pin force along AB with `--design`, N.
+        #[arg(long, default_value_t = 20e3)]
+        force: f64,
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 pub fn run(command: BenchCommand) -> Result<i32> {
@@ -124,6 +146,39 @@ pub fn run(command: BenchCommand) -> Result<i32> {
             json,
             ..
         } => bench_fem(designs, size.unwrap_or(5.0), force, json),
+        BenchCommand::Contact {
+            design: Some(design),
+            mesh: Some(mesh),
+            repeats,
+            force,
+            json,
+            ..
+        } => {
+            let b = crate::bench::contact::bench_contact_rod(&design, &mesh, force, repeats)?;
+            if json {
+                outln!("{}", serde_json::to_string_pretty(&b)?);
+            } else {
+                outln!(
+                    "{}: {} nodes, static cases {:.2} s, contact (F_x, 10 µm) {:.2} s, ratio \
+                     {:.2}; {} rows, {} columns; {:?}",
+                    design.display(),
+                    b.nodes,
+                    b.linear.as_secs_f64(),
+                    b.contact.as_secs_f64(),
+                    b.ratio,
+                    b.rows,
+                    b.columns,
+                    b.phases
+                );
+            }
+            Ok(0)
+        }
+        BenchCommand::Contact {
+            n_side,
+            repeats,
+            json,
+            ..
+        } => bench_contact(&n_side, repeats, json),
         BenchCommand::Dynamics {
             design,
             repeats,
@@ -286,6 +341,46 @@ fn bench_fem(designs: Vec<PathBuf>, size: f64, force: Option<f64>, json: bool) -
                 .as_f64()
                 .map_or("—".into(), |m| format!("{m:.0}"))
         );
+    }
+    Ok(0)
+}
+
+/// `bench contact`: [`crate::bench::contact::bench_contact`] per plate.
+fn bench_contact(n_side: &[usize], repeats: usize, json: bool) -> Result<i32> {
+    let mut rows = Vec::new();
+    if !json {
+        outln!(
+            "contact against the linear solve, two-eye plate, median of {repeats} runs\n\n\
+             | n_side | DOFs | linear [s] | contact [s] | contact / linear | rows | columns | \
+             iterations | assembly [s] | factorisation [s] | compliance [s] | active set [s] | \
+             rest [s] |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+        );
+    }
+    for &n in n_side {
+        let b = crate::bench::contact::bench_contact(n, repeats)?;
+        if !json {
+            let p = &b.phases;
+            outln!(
+                "| {} | {} | {:.2} | {:.2} | {:.2} | {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} |",
+                b.n_side,
+                b.dofs,
+                b.linear.as_secs_f64(),
+                b.contact.as_secs_f64(),
+                b.ratio,
+                b.rows,
+                b.columns,
+                b.iterations,
+                p.assembly_s,
+                p.factorisation_s,
+                p.columns_s,
+                p.active_set_s,
+                p.rest_s
+            );
+        }
+        rows.push(b);
+    }
+    if json {
+        outln!("{}", serde_json::to_string_pretty(&rows)?);
     }
     Ok(0)
 }

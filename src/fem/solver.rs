@@ -200,6 +200,59 @@ impl CholeskyFactor {
         llt.solve_in_place_with_conj(Conj::No, b, par, MemStack::new(&mut mem));
     }
 
+    /// The last `m` rows and columns of L, in the factor's order: with P K Pᵀ = L Lᵀ and the
+    /// partition of the ordered unknowns into (first n − m, last m), the trailing block L₂₂ is
+    /// the Cholesky factor of the Schur complement K₂₂ − K₂₁ K₁₁⁻¹ K₁₂, so that
+    /// (K⁻¹)₂₂ = L₂₂⁻ᵀ L₂₂⁻¹ (Golub & Van Loan, *Matrix Computations*, 4th ed., §4.2.7 and
+    /// §3.2.11). Returns the equations of those rows (`old[i]`: the equation at trailing row i)
+    /// and L₂₂ (dense, lower triangular; its strict upper triangle zero).
+    pub fn trailing_block(&self, m: usize) -> (Vec<usize>, faer::Mat<f64>) {
+        use faer::sparse::linalg::cholesky::SymbolicCholeskyRaw;
+        use faer::sparse::linalg::cholesky::supernodal::SupernodalLltRef;
+        let s = &*self.symbolic.inner;
+        let n = s.nrows();
+        let start = n - m.min(n);
+        let m = n - start;
+        let old: Vec<usize> = match s.perm() {
+            Some(p) => p.arrays().0[start..].to_vec(),
+            None => (start..n).collect(),
+        };
+        let mut l = faer::Mat::<f64>::zeros(m, m);
+        match s.raw() {
+            SymbolicCholeskyRaw::Supernodal(sn) => {
+                let llt = SupernodalLltRef::new(sn, &self.l_values);
+                for k in 0..sn.n_supernodes() {
+                    let (b, e) = (sn.supernode_begin()[k], sn.supernode_end()[k]);
+                    if e <= start {
+                        continue;
+                    }
+                    let node = llt.supernode(k);
+                    let (val, pattern) = (node.val(), node.pattern());
+                    let w = e - b;
+                    for c in b.max(start)..e {
+                        for r in 0..val.nrows() {
+                            let row = if r < w { b + r } else { pattern[r - w] };
+                            if row >= c {
+                                l[(row - start, c - start)] = val[(r, c - b)];
+                            }
+                        }
+                    }
+                }
+            }
+            SymbolicCholeskyRaw::Simplicial(sp) => {
+                let (col_ptr, row_idx) = (sp.col_ptr(), sp.row_idx());
+                for c in start..n {
+                    for p in col_ptr[c]..col_ptr[c + 1] {
+                        if row_idx[p] >= c {
+                            l[(row_idx[p] - start, c - start)] = self.l_values[p];
+                        }
+                    }
+                }
+            }
+        }
+        (old, l)
+    }
+
     /// The symbolic analysis used.
     pub fn symbolic(&self) -> &SymbolicFactor {
         &self.symbolic
@@ -247,6 +300,40 @@ mod tests {
         });
         let f = SymbolicFactor::analyse(&band, None).unwrap().flops();
         assert!(f > n as f64 && f < 10.0 * n as f64, "{f:e}");
+    }
+
+    #[test]
+    fn the_trailing_block_is_the_factor_of_the_schur_complement() {
+        // a 1D Laplacian plus a coupling of the ends, both factor kinds: (K⁻¹)₂₂ from the
+        // trailing block against K⁻¹'s columns solved directly
+        for n in [12, 400] {
+            let a = upper(n, |i, j| match j - i {
+                0 => Some(3.0),
+                1 => Some(-1.0),
+                d if d == n - 1 => Some(-0.5),
+                _ => None,
+            });
+            let order: Vec<usize> = (0..n).rev().collect();
+            let sym = SymbolicFactor::analyse(&a, Some(&order)).unwrap();
+            let f = CholeskyFactor::factorise(&sym, &a).unwrap();
+            let m = 5;
+            let (old, l) = f.trailing_block(m);
+            let mut x = faer::Mat::<f64>::identity(m, m);
+            faer::linalg::triangular_solve::solve_lower_triangular_in_place(
+                l.as_ref(),
+                x.as_mut(),
+                Par::Seq,
+            );
+            let inv = x.transpose() * &x;
+            for (c, &oc) in old.iter().enumerate() {
+                let mut e = vec![0.0; n];
+                e[oc] = 1.0;
+                f.solve_in_place(&mut e, 1);
+                for (r, &or) in old.iter().enumerate() {
+                    assert!((inv[(r, c)] - e[or]).abs() < 1e-13, "n {n}: {r} {c}");
+                }
+            }
+        }
     }
 
     #[test]

@@ -14,6 +14,7 @@ pub mod adapt;
 pub mod bores;
 pub mod buckling;
 pub mod cases;
+pub mod contact_load;
 pub mod cycle;
 pub mod facets;
 pub mod fatigue;

@@ -22,8 +22,8 @@
 //! H = E_Aᵀ S_AA⁻¹ E_A. A revisited active set (a cycle), an iteration limit, a non-positive S_AA
 //! or a near-singular H (the active contact cannot carry the load or hold the body) is an error.
 //!
-//! Only the columns of S on rows that are ever active are computed (each one solve with the
-//! factorised stiffness), through the callback `columns`.
+//! Only the columns of S on rows that are ever active are computed, through the callback
+//! `columns` ([`super::compliance`]).
 
 use std::collections::HashSet;
 

@@ -16,6 +16,7 @@
 //! See `docs/contact.md` for the formulation, the verification and the cost.
 
 pub mod check;
+pub mod compliance;
 pub mod cylinder;
 pub mod lcp;
 pub mod measures;

@@ -118,7 +118,7 @@ pub struct ContactTimings {
     pub assembly_s: f64,
     /// Ordering, symbolic and numeric Cholesky.
     pub factorisation_s: f64,
-    /// Columns of the contact compliance (one solve per column, blocked).
+    /// Columns of the contact compliance ([`super::compliance`]).
     pub columns_s: f64,
     /// Active-set iterations (dense).
     pub active_set_s: f64,

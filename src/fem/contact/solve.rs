@@ -22,13 +22,16 @@
 //! pure rotation, and the support's reaction a pure couple about the pin's axis (plus a force
 //! along it for the sliding).
 //!
-//! Cost: one assembly and one Cholesky factorisation, one solve per column of S that the
-//! active-set iteration needs (the rows ever active, blocked 32 at a time), dense Cholesky of
-//! the active block per iteration, and two more solves (the free and the final displacement).
+//! Cost: one assembly and one Cholesky factorisation (of K in the wall nodes' radial frames,
+//! the radial equations last), the columns of S that the active-set iteration needs (the rows
+//! ever active) by dense triangular solves with the factor's trailing block
+//! ([`super::compliance`]), dense Cholesky of the active block per iteration, and two more
+//! solves (the free and the final displacement).
 
 use std::time::Instant;
 
 use super::check::check;
+use super::compliance::{Compliance, NodalFrames};
 use super::cylinder::PinMotion;
 use super::lcp::{MixedLcp, solve as solve_lcp};
 use super::measures::summarise;
@@ -40,9 +43,6 @@ use crate::fem::boundary::{dot, norm};
 use crate::fem::error::{FemError, Result};
 use crate::fem::ordering::nested_dissection;
 use crate::fem::solver::{CholeskyFactor, SymbolicFactor};
-
-/// Columns of the contact compliance solved together.
-const BLOCK: usize = 32;
 
 /// Solves `problem`; a solution that fails its check ([`super::check`]) is refused.
 pub fn solve_contact(problem: &ContactProblem) -> Result<ContactSolution> {
@@ -97,10 +97,32 @@ pub fn solve_contact(problem: &ContactProblem) -> Result<ContactSolution> {
     let asm = assemble(mesh, &problem.material, problem.quadrature, &dofs)?;
     timings.assembly_s = t.elapsed().as_secs_f64();
     let t = Instant::now();
+    // in the wall nodes' radial frames, the radial equations last ([`super::compliance`])
+    let rotated =
+        NodalFrames::new(&walls, &dofs).and_then(|f| f.rotate_matrix(&asm.k).map(|k| (f, k)));
     let order = nested_dissection(mesh, &dofs)?;
-    let symbolic = SymbolicFactor::analyse(&asm.k, Some(&order))?;
-    let factor = CholeskyFactor::factorise(&symbolic, &asm.k)?;
+    let (frames, factor) = match rotated {
+        Some((f, k_rot)) => {
+            let order = f.order_last(&order);
+            let symbolic = SymbolicFactor::analyse(&k_rot, Some(&order))?;
+            (Some(f), CholeskyFactor::factorise(&symbolic, &k_rot)?)
+        }
+        None => {
+            let symbolic = SymbolicFactor::analyse(&asm.k, Some(&order))?;
+            (None, CholeskyFactor::factorise(&symbolic, &asm.k)?)
+        }
+    };
     timings.factorisation_s = t.elapsed().as_secs_f64();
+    // K x = b through the factor (of K' = Tᵀ K T when rotated: x = T K'⁻¹ Tᵀ b)
+    let solve_k = |b: &mut [f64]| {
+        if let Some(f) = &frames {
+            f.rotate(b, true);
+        }
+        factor.solve_in_place(b, 1);
+        if let Some(f) = &frames {
+            f.rotate(b, false);
+        }
+    };
 
     let t = Instant::now();
     let loads = if problem.loads.is_empty() {
@@ -123,7 +145,7 @@ pub fn solve_contact(problem: &ContactProblem) -> Result<ContactSolution> {
         b
     };
     let mut x0 = rhs_of(&loads);
-    factor.solve_in_place(&mut x0, 1);
+    solve_k(&mut x0);
     let u0 = to_full(&x0);
     // rows: (wall, b); the equation numbers of the wall nodes' DOFs
     let rows: Vec<(usize, usize)> = walls
@@ -261,44 +283,15 @@ pub fn solve_contact(problem: &ContactProblem) -> Result<ContactSolution> {
                 .collect()
         })
         .collect();
-    let apply_c = |x: &[f64]| -> Vec<f64> {
-        rows.iter()
-            .map(|&(w, b)| {
-                let wall = &walls[w];
-                wall.weights[b]
-                    .iter()
-                    .map(|&(a, d)| {
-                        d * (0..3)
-                            .map(|j| eqs[w][a][j].map_or(0.0, |qd| wall.e[a][j] * x[qd]))
-                            .sum::<f64>()
-                    })
-                    .sum()
-            })
-            .collect()
+    let compliance = match &frames {
+        Some(f) => Compliance::trailing(&factor, &walls, &f.radial())?,
+        None => Compliance::solves(&factor, n_eq, &walls, &eqs),
     };
     timings.rest_s += t.elapsed().as_secs_f64();
     let mut columns_s = 0.0;
     let mut columns = |js: &[usize]| -> Result<Vec<Vec<f64>>> {
         let t = Instant::now();
-        let mut out = Vec::with_capacity(js.len());
-        for chunk in js.chunks(BLOCK) {
-            let mut rhs = vec![0.0; n_eq * chunk.len()];
-            for (c, &j) in chunk.iter().enumerate() {
-                let (w, b) = rows[j];
-                let wall = &walls[w];
-                for &(a, d) in &wall.weights[b] {
-                    for (eq, ej) in eqs[w][a].iter().zip(wall.e[a]) {
-                        if let Some(qd) = eq {
-                            rhs[c * n_eq + qd] += d * ej;
-                        }
-                    }
-                }
-            }
-            factor.solve_in_place(&mut rhs, chunk.len());
-            for c in 0..chunk.len() {
-                out.push(apply_c(&rhs[c * n_eq..(c + 1) * n_eq]));
-            }
-        }
+        let out = compliance.columns(js);
         columns_s += t.elapsed().as_secs_f64();
         Ok(out)
     };
@@ -327,7 +320,7 @@ pub fn solve_contact(problem: &ContactProblem) -> Result<ContactSolution> {
         w.add_forces(lam, &mut f);
     }
     let mut x = rhs_of(&f);
-    factor.solve_in_place(&mut x, 1);
+    solve_k(&mut x);
     let mut u = to_full(&x);
     fl.add_motion(mesh, &y[..k], &mut u);
     let pins: Vec<[f64; 3]> = (0..walls.len())
