@@ -215,7 +215,8 @@ fn solve_step(
     let pattern = ReducedPattern::new(model.nodes.len(), &sys.connectivity, &reduction);
     let k_of = |e: usize| Ok(stiffness(&sys.points[e], &sys.material[e].0));
     let (k, dirichlet) = pattern.assemble(&sys.connectivity, &reduction, k_of)?;
-    let factor = factorise(&k).map_err(|e| at(e.to_string()))?;
+    let factor = factorise(&k, model.nodes.len(), &sys.connectivity, &reduction)
+        .map_err(|e| at(e.to_string()))?;
     let analysis = step.analysis.unwrap_or_default();
     let mut f = step_loads(path, model, sys, step, number)?;
     if matches!(analysis, Analysis::Frequency { .. }) {

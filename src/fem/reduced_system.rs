@@ -13,6 +13,7 @@ use nalgebra::DMatrix;
 use super::assembly::SparseSym;
 use super::constraints::Reduction;
 use super::error::{FemError, Result};
+use super::ordering::nested_dissection_reduced;
 use super::solver::{CholeskyFactor, SymbolicFactor};
 
 /// The pattern of Tᵀ A T for elements with the given nodes (3 DOFs per node).
@@ -140,13 +141,20 @@ impl ReducedPattern {
     }
 }
 
-/// The Cholesky factor of a reduced stiffness (approximate minimum degree order). A matrix that
-/// is not positive definite — supports that leave a rigid-body motion free — is refused.
-pub fn factorise(k: &SparseSym) -> Result<CholeskyFactor> {
+/// The Cholesky factor of a reduced stiffness `k` of the tetrahedra `elements` on `n_nodes`
+/// nodes, in nested-dissection order ([`nested_dissection_reduced`]). A matrix that is not
+/// positive definite — supports that leave a rigid-body motion free — is refused.
+pub fn factorise<E: AsRef<[usize]>>(
+    k: &SparseSym,
+    n_nodes: usize,
+    elements: &[E],
+    reduction: &Reduction,
+) -> Result<CholeskyFactor> {
     if k.n == 0 {
         return Err(FemError::InvalidInput("every DOF is constrained".into()));
     }
-    let symbolic = SymbolicFactor::analyse(k, None)?;
+    let order = nested_dissection_reduced(n_nodes, elements, reduction)?;
+    let symbolic = SymbolicFactor::analyse(k, Some(&order))?;
     CholeskyFactor::factorise(&symbolic, k)
 }
 
