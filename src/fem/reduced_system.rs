@@ -102,10 +102,7 @@ impl ReducedPattern {
         let with_rhs = reduction.has_offset();
         for (e, el) in elements.iter().enumerate() {
             let a = matrix(e)?;
-            let dofs: Vec<usize> = el
-                .iter()
-                .flat_map(|&n| (0..3).map(move |j| 3 * n + j))
-                .collect();
+            let dofs = element_dofs(el);
             for (i, &di) in dofs.iter().enumerate() {
                 let ri = reduction.row(di);
                 if ri.is_empty() {
@@ -158,6 +155,14 @@ pub fn factorise<E: AsRef<[usize]>>(
     CholeskyFactor::factorise(&symbolic, k)
 }
 
+/// The DOFs of an element's nodes, 3 per node.
+fn element_dofs(nodes: &[usize]) -> Vec<usize> {
+    nodes
+        .iter()
+        .flat_map(|&n| (0..3).map(move |j| 3 * n + j))
+        .collect()
+}
+
 /// Σ_e A_e u_e: the element matrices times the full vector `u`, summed per DOF (internal forces
 /// K u for the stiffness).
 pub fn element_product(
@@ -169,10 +174,7 @@ pub fn element_product(
     let mut out = vec![0.0; n_dofs];
     for (e, el) in elements.iter().enumerate() {
         let a = matrix(e)?;
-        let dofs: Vec<usize> = el
-            .iter()
-            .flat_map(|&n| (0..3).map(move |j| 3 * n + j))
-            .collect();
+        let dofs = element_dofs(el);
         for (i, &di) in dofs.iter().enumerate() {
             out[di] += dofs
                 .iter()
