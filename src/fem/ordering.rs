@@ -204,6 +204,44 @@ mod tests {
     }
 
     #[test]
+    fn the_reduced_order_without_ties_is_the_kernels_order() {
+        use crate::fem::constraints::{Constraint, Reduction};
+        let (mesh, dofs, _) = clamped_box(3);
+        let constraints: Vec<Constraint> = (0..mesh.n_dofs())
+            .filter(|&d| dofs.eq(d).is_none())
+            .map(|d| Constraint {
+                terms: vec![(d, 1.0)],
+                value: 0.0,
+                label: format!("DOF {d}"),
+            })
+            .collect();
+        let reduction = Reduction::new(mesh.n_dofs(), &constraints).unwrap();
+        assert_eq!(reduction.n_eq(), dofs.n_eq());
+        // each order as the sequence of the DOFs its equations stand for
+        let mut dof_of_eq = vec![0; dofs.n_eq()];
+        let mut dof_of_q = vec![0; reduction.n_eq()];
+        for d in 0..mesh.n_dofs() {
+            if let Some(q) = dofs.eq(d) {
+                dof_of_eq[q] = d;
+                assert_eq!(reduction.row(d).len(), 1);
+                dof_of_q[reduction.row(d)[0].0] = d;
+            }
+        }
+        let kernel: Vec<usize> = nested_dissection(&mesh, &dofs)
+            .unwrap()
+            .iter()
+            .map(|&q| dof_of_eq[q])
+            .collect();
+        let reduced: Vec<usize> =
+            nested_dissection_reduced(mesh.n_nodes(), mesh.elements(), &reduction)
+                .unwrap()
+                .iter()
+                .map(|&q| dof_of_q[q])
+                .collect();
+        assert_eq!(kernel, reduced);
+    }
+
+    #[test]
     fn nested_dissection_fills_less_than_minimum_degree_and_solves_the_same_system() {
         // 16 × 8 × 8 cells: 3D enough that nested dissection's separators pay off
         let (mesh, dofs, asm) = clamped_box(8);
