@@ -114,7 +114,8 @@ pub struct StepResult {
     pub residual_rel: f64,
     /// Independent DOFs (equations).
     pub equations: usize,
-    /// Seconds: assembly and factorisation, solve and results.
+    /// Seconds: assembly and factorisation (none when the step reuses the previous step's
+    /// factor), solve and results.
     pub wall_s: f64,
     /// Variables of `*NODE FILE`/`*EL FILE` (for the VTU file).
     #[serde(skip)]
@@ -189,15 +190,17 @@ pub fn solve_model_at(path: &Path, model: &Model, options: SolveOptions) -> Resu
     let mut last: Option<StepSystem> = None;
     for (k, step) in model.steps.iter().enumerate() {
         let number = k + 1;
+        let t = Instant::now();
         let at = at_step(number, step);
         let reduction = step_reduction(path, model, &sys, step)?;
         let system = match last.take() {
             Some(s) if s.reduction == reduction => s,
             _ => step_system(model, &sys, reduction).map_err(|e| at(e.to_string()))?,
         };
-        steps.push(solve_step(
-            path, model, &sys, &system, step, number, options,
-        )?);
+        let mut result = solve_step(path, model, &sys, &system, step, number, options)?;
+        // the step's time includes the building of its system
+        result.wall_s = t.elapsed().as_secs_f64();
+        steps.push(result);
         last = Some(system);
     }
     Ok(DeckSolution {
