@@ -7,7 +7,7 @@
 //! ccx's E).
 
 use super::system::DeckSystem;
-use crate::fem::nodal_stress::Extrapolation;
+use crate::fem::nodal_stress::{Extrapolation, nodal_mean};
 use crate::fem::shape::TET10_EDGES;
 use crate::fem::solid_element::strain;
 
@@ -66,16 +66,6 @@ pub fn field(sys: &DeckSystem, u: &[f64], stress: bool, extrapolation: Extrapola
             count[n] += 1;
         }
     }
-    let nodal = sum
-        .iter()
-        .zip(&count)
-        .map(|(s, &n)| {
-            if n == 0 {
-                [0.0; 6]
-            } else {
-                s.map(|v| v / f64::from(n))
-            }
-        })
-        .collect();
+    let nodal = nodal_mean(&sum, &count);
     Field { points, nodal }
 }

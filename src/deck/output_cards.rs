@@ -90,8 +90,11 @@ impl Model {
             ));
         }
         // ccx prints the values of a node with local axes (*TRANSFORM) in them unless
-        // GLOBAL=YES; rodstudy prints global components only, so it asks for GLOBAL=YES there
+        // GLOBAL=YES; rodstudy prints global components only, so it asks for GLOBAL=YES there.
+        // Totals alone (TOTALS=ONLY, as FreeCAD writes for its constraints) ccx sums in global
+        // axes.
         if kw == "NODE PRINT"
+            && totals != Totals::Only
             && card.param("GLOBAL").is_none()
             && let Some(set) = card.param("NSET")
             && let Some(nodes) = self.nsets.get(&set.to_ascii_uppercase())

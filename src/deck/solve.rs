@@ -23,10 +23,13 @@ use serde::Serialize;
 use super::fields::field;
 use super::model::{Analysis, Model, Step, Totals};
 use super::system::{DeckSystem, deck_system, merged_requests, step_loads, step_reduction};
+use crate::fem::assembly::SparseSym;
+use crate::fem::constraints::Reduction;
 use crate::fem::error::{FemError, Result};
 use crate::fem::nodal_stress::Extrapolation;
 use crate::fem::reduced_system::{ReducedPattern, element_product, factorise};
 use crate::fem::solid_element::{geometric_stiffness, mass, stiffness};
+use crate::fem::solver::CholeskyFactor;
 use crate::fem::subspace::lowest_eigenpairs;
 
 /// Options of [`solve_model`].
@@ -111,7 +114,8 @@ pub struct StepResult {
     pub residual_rel: f64,
     /// Independent DOFs (equations).
     pub equations: usize,
-    /// Seconds: assembly and factorisation, solve and results.
+    /// Seconds: assembly and factorisation (none when the step reuses the previous step's
+    /// factor), solve and results.
     pub wall_s: f64,
     /// Variables of `*NODE FILE`/`*EL FILE` (for the VTU file).
     #[serde(skip)]
@@ -183,8 +187,21 @@ pub fn solve_model_at(path: &Path, model: &Model, options: SolveOptions) -> Resu
         ));
     }
     let mut steps = Vec::with_capacity(model.steps.len());
+    let mut last: Option<StepSystem> = None;
     for (k, step) in model.steps.iter().enumerate() {
-        steps.push(solve_step(path, model, &sys, step, k + 1, options)?);
+        let number = k + 1;
+        let t = Instant::now();
+        let at = at_step(number, step);
+        let reduction = step_reduction(path, model, &sys, step)?;
+        let system = match last.take() {
+            Some(s) if s.reduction == reduction => s,
+            _ => step_system(model, &sys, reduction).map_err(|e| at(e.to_string()))?,
+        };
+        let mut result = solve_step(path, model, &sys, &system, step, number, options)?;
+        // the step's time includes the building of its system
+        result.wall_s = t.elapsed().as_secs_f64();
+        steps.push(result);
+        last = Some(system);
     }
     Ok(DeckSolution {
         node_ids: model.node_ids.clone(),
@@ -201,21 +218,55 @@ pub fn solve_model_at(path: &Path, model: &Model, options: SolveOptions) -> Resu
     })
 }
 
+/// The reduced stiffness of a step's constraints, factorised; a later step with the same
+/// constraints (supports, local axes, equations and prescribed values) uses it again.
+struct StepSystem {
+    reduction: Reduction,
+    pattern: ReducedPattern,
+    k: SparseSym,
+    dirichlet: Vec<f64>,
+    factor: CholeskyFactor,
+}
+
+fn step_system(model: &Model, sys: &DeckSystem, reduction: Reduction) -> Result<StepSystem> {
+    let pattern = ReducedPattern::new(model.nodes.len(), &sys.connectivity, &reduction);
+    let (k, dirichlet) = pattern.assemble(&sys.connectivity, &reduction, |e| {
+        Ok(stiffness(&sys.points[e], &sys.material[e].0))
+    })?;
+    let factor = factorise(&k, model.nodes.len(), &sys.connectivity, &reduction)?;
+    Ok(StepSystem {
+        reduction,
+        pattern,
+        k,
+        dirichlet,
+        factor,
+    })
+}
+
+/// Errors of step `number`, naming its line.
+fn at_step(number: usize, step: &Step) -> impl Fn(String) -> FemError + '_ {
+    move |m: String| FemError::InvalidInput(format!("step {number} (line {}): {m}", step.line))
+}
+
 fn solve_step(
     path: &Path,
     model: &Model,
     sys: &DeckSystem,
+    system: &StepSystem,
     step: &Step,
     number: usize,
     options: SolveOptions,
 ) -> Result<StepResult> {
     let t = Instant::now();
-    let at = |m: String| FemError::InvalidInput(format!("step {number} (line {}): {m}", step.line));
-    let reduction = step_reduction(path, model, sys, step)?;
-    let pattern = ReducedPattern::new(model.nodes.len(), &sys.connectivity, &reduction);
+    let at = at_step(number, step);
+    let StepSystem {
+        reduction,
+        pattern,
+        k,
+        dirichlet,
+        factor,
+    } = system;
     let k_of = |e: usize| Ok(stiffness(&sys.points[e], &sys.material[e].0));
-    let (k, dirichlet) = pattern.assemble(&sys.connectivity, &reduction, k_of)?;
-    let factor = factorise(&k).map_err(|e| at(e.to_string()))?;
     let analysis = step.analysis.unwrap_or_default();
     let mut f = step_loads(path, model, sys, step, number)?;
     if matches!(analysis, Analysis::Frequency { .. }) {
@@ -227,7 +278,7 @@ fn solve_step(
         applied_total[i % 3] += v;
     }
     let mut b = reduction.restrict(&f);
-    for (bi, di) in b.iter_mut().zip(&dirichlet) {
+    for (bi, di) in b.iter_mut().zip(dirichlet) {
         *bi += di;
     }
     let mut q = b.clone();
@@ -271,12 +322,12 @@ fn solve_step(
     let eigen = match analysis {
         Analysis::Static => None,
         Analysis::Buckle { modes, accuracy } => {
-            let (g, _) = pattern.assemble(&sys.connectivity, &reduction, |e| {
+            let (g, _) = pattern.assemble(&sys.connectivity, reduction, |e| {
                 let neg: Vec<[f64; 6]> = stress.points[e].iter().map(|s| s.map(|v| -v)).collect();
                 Ok(geometric_stiffness(&sys.points[e], &neg))
             })?;
             let tol = (accuracy * 1e-6).min(1e-9);
-            let pairs = lowest_eigenpairs(&factor, &g, &q, modes, tol, 1000).map_err(|e| {
+            let pairs = lowest_eigenpairs(factor, &g, &q, modes, tol, 1000).map_err(|e| {
                 at(format!(
                     "*BUCKLE: {e} (no positive buckling factor: the loads stiffen the model, e.g. \
                      tension)"
@@ -296,7 +347,7 @@ fn solve_step(
             upper,
         } => {
             let mut rho_missing = None;
-            let (m, _) = pattern.assemble(&sys.connectivity, &reduction, |e| {
+            let (m, _) = pattern.assemble(&sys.connectivity, reduction, |e| {
                 let rho = sys.material[e].1.unwrap_or_else(|| {
                     rho_missing.get_or_insert(e);
                     0.0
@@ -310,7 +361,7 @@ fn solve_step(
                 )));
             }
             let start: Vec<f64> = (0..m.n).map(|i| 1.0 + (i % 3) as f64).collect();
-            let pairs = lowest_eigenpairs(&factor, &m, &start, modes, 1e-10, 1000)
+            let pairs = lowest_eigenpairs(factor, &m, &start, modes, 1e-10, 1000)
                 .map_err(|e| at(format!("*FREQUENCY: {e}")))?;
             let two_pi = 2.0 * std::f64::consts::PI;
             let mut values = Vec::new();

@@ -8,24 +8,12 @@
 //! *Concepts and Applications of FEA*, 4th ed., §18.6). The load λ·f is the buckling load of the
 //! linearised (pre-buckling deformation neglected) problem.
 //!
-//! **Eigen-solver.** With μ = 1/λ the problem is the standard one A φ = μ φ for A = K⁻¹(−K_σ),
-//! symmetric in the K inner product; the smallest positive λ is the largest positive μ. Inverse
-//! subspace iteration with Rayleigh–Ritz (Bathe §11.6; the "shift-and-invert" form with zero
-//! shift, so that the one Cholesky factor of K — the one the static solve already used — serves
-//! every iteration): a block X of p vectors,
-//!
-//! 1. Y = −K_σ X, X̄ = K⁻¹ Y (one multi-right-hand-side solve with the factor of K; after the
-//!    first iteration Y is carried over as (−K_σ X̄) Z from step 3, Bathe §11.6.3, so that each
-//!    iteration multiplies by K_σ once);
-//! 2. the projections K_r = X̄ᵀ K X̄ = X̄ᵀ Y and G_r = X̄ᵀ (−K_σ) X̄;
-//! 3. the small dense problem G_r z = μ K_r z (K_r = L Lᵀ, the symmetric eigenproblem of
-//!    L⁻¹ G_r L⁻ᵀ, nalgebra), X ← X̄ Z, K-orthonormal;
-//!
-//! until the largest positive Ritz value changes by at most `tolerance` (relative) between
-//! iterations. The block converges to the p eigenvalues of largest |μ| at the rate
-//! |μ_{p+1}/μ_i| per iteration; both signs occur (a negative λ is the buckling factor of the
-//! reversed load). When no positive Ritz value is found the load stiffens every mode the block
-//! found (a tensile stress state) and the problem is refused.
+//! **Eigen-solver.** With μ = 1/λ the smallest positive λ is the largest positive μ of
+//! K⁻¹(−K_σ): inverse subspace iteration with Rayleigh–Ritz on the one Cholesky factor of K —
+//! the one the static solve already used — ([`super::subspace`]), here with a block of
+//! `options.block` vectors started from the load's pattern, converged on λ₁ alone. When no
+//! positive Ritz value is found the load stiffens every mode the block found (a tensile stress
+//! state) and the problem is refused.
 
 use std::time::Instant;
 
@@ -41,6 +29,7 @@ use super::mesh::TetMesh;
 use super::ordering::nested_dissection;
 use super::solver::{CholeskyFactor, SymbolicFactor};
 use super::statics::FactorisedSystem;
+use super::subspace::subspace_iteration;
 
 /// Options of [`solve_buckling`].
 #[derive(Clone, Copy, Debug, Serialize, Deserialize)]
@@ -156,27 +145,6 @@ pub fn assemble_geometric(
         col_ptr: k.col_ptr.clone(),
         row_idx: k.row_idx.clone(),
         values,
-    })
-}
-
-/// y = A X for the `p` columns of `x` (column after column), in parallel over the columns.
-fn mul_block(a: &SparseSym, x: &[f64], p: usize) -> Vec<f64> {
-    let n = a.n;
-    let cols: Vec<Vec<f64>> = (0..p)
-        .into_par_iter()
-        .map(|j| a.mul(&x[j * n..(j + 1) * n]))
-        .collect();
-    cols.concat()
-}
-
-/// XᵀY for two n × p blocks (column-major).
-fn gram(x: &[f64], y: &[f64], n: usize, p: usize) -> nalgebra::DMatrix<f64> {
-    nalgebra::DMatrix::from_fn(p, p, |i, j| {
-        x[i * n..(i + 1) * n]
-            .iter()
-            .zip(&y[j * n..(j + 1) * n])
-            .map(|(a, b)| a * b)
-            .sum()
     })
 }
 
@@ -311,99 +279,25 @@ fn buckling_on(
 
     let t2 = Instant::now();
     let p = options.block.min(n);
-    let mut x = start_block(&uf, n, p);
-    let mut previous: Option<f64> = None;
-    let mut ritz: Vec<f64> = Vec::new();
-    let mut lambda = f64::NAN;
-    let mut iterations = 0;
-    let mut converged = false;
-    let mut largest_previous = f64::NAN;
-    // Y = G X; after the first iteration carried over as (G X̄) Q (Bathe §11.6.3), so that each
-    // iteration multiplies by G once
-    let mut y = mul_block(&g, &x, p);
-    for it in 1..=options.max_iterations {
-        iterations = it;
-        let mut xb = y.clone();
-        factor.solve_in_place(&mut xb, p);
-        let kr = gram(&xb, &y, n, p);
-        let gx = mul_block(&g, &xb, p);
-        let gr = gram(&xb, &gx, n, p);
-        let kr = 0.5 * (&kr + kr.transpose());
-        let gr = 0.5 * (&gr + gr.transpose());
-        let chol = nalgebra::Cholesky::new(kr).ok_or_else(|| {
-            FemError::Solver(
-                "buckling: the projected stiffness is not positive definite (the block \
-                 collapsed: −K_σ has fewer than `block` independent directions)"
-                    .into(),
-            )
-        })?;
-        let l = chol.l();
-        let linv = l
-            .clone()
-            .try_inverse()
-            .ok_or_else(|| FemError::Solver("buckling: singular projected stiffness".into()))?;
-        let c = &linv * &gr * linv.transpose();
-        let c = 0.5 * (&c + c.transpose());
-        let eig = nalgebra::SymmetricEigen::new(c);
-        // descending μ: the largest positive first
-        let mut order: Vec<usize> = (0..p).collect();
-        order.sort_by(|&i, &j| eig.eigenvalues[j].total_cmp(&eig.eigenvalues[i]));
-        let z = linv.transpose() * &eig.eigenvectors;
-        // X = X̄ Q and Y = (G X̄) Q, Q the Ritz vectors in descending μ
-        let combine = |block: &[f64]| -> Vec<f64> {
-            let mut out = vec![0.0; n * p];
-            for (k, &col) in order.iter().enumerate() {
-                let o = &mut out[k * n..(k + 1) * n];
-                for m in 0..p {
-                    let w = z[(m, col)];
-                    if w != 0.0 {
-                        for (o, v) in o.iter_mut().zip(&block[m * n..(m + 1) * n]) {
-                            *o += w * v;
-                        }
-                    }
-                }
-            }
-            out
-        };
-        x = combine(&xb);
-        y = combine(&gx);
-        let mus: Vec<f64> = order.iter().map(|&i| eig.eigenvalues[i]).collect();
-        let scale = mus.iter().fold(0.0f64, |a, m| a.max(m.abs()));
-        ritz = mus.iter().map(|m| 1.0 / m).collect();
-        let largest = mus[0];
-        if largest > 1e-9 * scale {
-            lambda = 1.0 / largest;
-            if let Some(prev) = previous
-                && (lambda - prev).abs() <= options.tolerance * lambda
-            {
-                converged = true;
-                break;
-            }
-            previous = Some(lambda);
-        } else {
-            // no positive Ritz value: stop once the block's dominant value has settled
-            let dominant = mus[p - 1];
-            if (dominant - largest_previous).abs() <= options.tolerance * dominant.abs() {
-                return Err(FemError::InvalidInput(format!(
-                    "no positive buckling load factor: the load stiffens every mode found (a \
-                     tensile stress state; the {p} eigenvalues of largest magnitude are all \
-                     negative, the nearest λ = {:.4e} is the factor of the reversed load)",
-                    1.0 / dominant
-                )));
-            }
-            largest_previous = dominant;
-            previous = None;
-        }
-    }
-    if !converged {
-        return Err(FemError::Solver(format!(
-            "buckling: the subspace iteration did not converge to {:.0e} in {} iterations \
-             (last λ₁ = {lambda:.6e})",
-            options.tolerance, options.max_iterations
-        )));
-    }
+    let pairs = subspace_iteration(
+        factor,
+        &g,
+        start_block(&uf, n, p),
+        1,
+        options.tolerance,
+        options.max_iterations,
+    )
+    .map_err(|e| match e {
+        FemError::InvalidInput(m) => FemError::InvalidInput(format!(
+            "no positive buckling load factor: the load stiffens every mode found (a tensile \
+             stress state; {m}, the factor of the reversed load)"
+        )),
+        FemError::Solver(m) => FemError::Solver(format!("buckling: {m}")),
+        other => other,
+    })?;
+    let (lambda, iterations, ritz) = (pairs.values[0], pairs.iterations, pairs.ritz);
     // the mode, its residual, its scale
-    let phi = &x[..n];
+    let phi = &pairs.vectors[0];
     let kphi = system.k.mul(phi);
     let gphi = g.mul(phi);
     let num: f64 = kphi

@@ -32,7 +32,7 @@ pub struct Constraint {
 }
 
 /// u = T q + g for every DOF.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Reduction {
     /// Per DOF its row of T: (equation, coefficient).
     rows: Vec<Vec<(usize, f64)>>,

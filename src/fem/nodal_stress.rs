@@ -106,9 +106,18 @@ pub fn calculix_nodal_stress(
             count[el[a]] += 1;
         }
     }
-    let nodal = sum
-        .iter()
-        .zip(&count)
+    let nodal = nodal_mean(&sum, &count);
+    Ok(NodalStress {
+        integration_points,
+        nodal,
+    })
+}
+
+/// Per node the mean of the values its elements gave it (`sum` over `count` elements; zero on
+/// a node of no element).
+pub fn nodal_mean(sum: &[[f64; 6]], count: &[u32]) -> Vec<[f64; 6]> {
+    sum.iter()
+        .zip(count)
         .map(|(s, &n)| {
             if n == 0 {
                 [0.0; 6]
@@ -116,11 +125,7 @@ pub fn calculix_nodal_stress(
                 s.map(|v| v / f64::from(n))
             }
         })
-        .collect();
-    Ok(NodalStress {
-        integration_points,
-        nodal,
-    })
+        .collect()
 }
 
 #[cfg(test)]

@@ -11,19 +11,57 @@
 use metis_sys as m;
 
 use super::assembly::DofMap;
+use super::constraints::Reduction;
 use super::error::{FemError, Result};
 use super::mesh::TetMesh;
 use super::shape::TET10_EDGES;
 
 /// The nested-dissection order of the equations of `dofs` on `mesh`: `fwd[new] = old`.
 pub fn nested_dissection(mesh: &TetMesh, dofs: &DofMap) -> Result<Vec<usize>> {
-    let n_nodes = mesh.n_nodes();
+    let order = node_order(mesh.n_nodes(), mesh.elements())?;
+    Ok(order
+        .iter()
+        .flat_map(|&v| (0..3).filter_map(move |c| dofs.eq(3 * v + c)))
+        .collect())
+}
+
+/// The nested-dissection order of the equations of a [`Reduction`] (u = T q + g) on tetrahedra
+/// given by their node lists (4 corners, then for a tet10 the midside nodes in
+/// [`TET10_EDGES`] order): `fwd[new] = old`. An equation enters T's rows of several nodes' DOFs
+/// where a constraint ties them (a local-axes node, an `*EQUATION`, a reference node); it is
+/// placed with the latest of those nodes, so that eliminating it never joins nodes not yet
+/// eliminated. Without ties this is [`nested_dissection`]'s order.
+pub fn nested_dissection_reduced<E: AsRef<[usize]>>(
+    n_nodes: usize,
+    elements: &[E],
+    reduction: &Reduction,
+) -> Result<Vec<usize>> {
+    let order = node_order(n_nodes, elements)?;
+    const NONE: usize = usize::MAX;
+    let mut key = vec![NONE; reduction.n_eq()];
+    for (pos, &v) in order.iter().enumerate() {
+        for c in 0..3 {
+            for &(q, _) in reduction.row(3 * v + c) {
+                // `order` ascends in pos: the last node seen is the latest
+                key[q] = pos;
+            }
+        }
+    }
+    let mut fwd: Vec<usize> = (0..reduction.n_eq()).collect();
+    fwd.sort_by_key(|&q| (key[q], q));
+    Ok(fwd)
+}
+
+/// The nodes of tetrahedra (corners first, midside nodes in [`TET10_EDGES`] order) in
+/// nested-dissection order: the corners by METIS on the corner graph, each midside node just
+/// after the earlier of its edge's corners, nodes in no element last.
+fn node_order<E: AsRef<[usize]>>(n_nodes: usize, elements: &[E]) -> Result<Vec<usize>> {
     // Corner nodes, numbered 0..n_corners.
     const NONE: usize = usize::MAX;
     let mut corner = vec![NONE; n_nodes];
     let mut corners = Vec::new();
-    for el in mesh.elements() {
-        for &v in &el[..4] {
+    for el in elements {
+        for &v in &el.as_ref()[..4] {
             if corner[v] == NONE {
                 corner[v] = corners.len();
                 corners.push(v);
@@ -33,7 +71,8 @@ pub fn nested_dissection(mesh: &TetMesh, dofs: &DofMap) -> Result<Vec<usize>> {
     let nc = corners.len();
     // The corner graph: each element's six edges, both directions, duplicates removed.
     let mut adj: Vec<Vec<u32>> = vec![Vec::new(); nc];
-    for el in mesh.elements() {
+    for el in elements {
+        let el = el.as_ref();
         for [a, b] in TET10_EDGES {
             let (ca, cb) = (corner[el[a]], corner[el[b]]);
             adj[ca].push(cb as u32);
@@ -62,18 +101,20 @@ pub fn nested_dissection(mesh: &TetMesh, dofs: &DofMap) -> Result<Vec<usize>> {
     for (c, &v) in corners.iter().enumerate() {
         key[v] = (rank[c], 0);
     }
-    for el in mesh.elements() {
-        for (k, [a, b]) in TET10_EDGES.iter().enumerate() {
+    for el in elements {
+        let el = el.as_ref();
+        for (k, [a, b]) in TET10_EDGES
+            .iter()
+            .enumerate()
+            .take(el.len().saturating_sub(4))
+        {
             let r = rank[corner[el[*a]]].min(rank[corner[el[*b]]]);
             key[el[4 + k]] = (r, 1);
         }
     }
     let mut order: Vec<usize> = (0..n_nodes).collect();
     order.sort_unstable_by_key(|&v| (key[v], v));
-    Ok(order
-        .iter()
-        .flat_map(|&v| (0..3).filter_map(move |c| dofs.eq(3 * v + c)))
-        .collect())
+    Ok(order)
 }
 
 /// METIS_NodeND on a graph in CSR form (0-based, no self-loops): each vertex's rank in the
@@ -160,6 +201,44 @@ mod tests {
         for w in fwd.chunks(3) {
             assert_eq!(w, [w[0], w[0] + 1, w[0] + 2]);
         }
+    }
+
+    #[test]
+    fn the_reduced_order_without_ties_is_the_kernels_order() {
+        use crate::fem::constraints::{Constraint, Reduction};
+        let (mesh, dofs, _) = clamped_box(3);
+        let constraints: Vec<Constraint> = (0..mesh.n_dofs())
+            .filter(|&d| dofs.eq(d).is_none())
+            .map(|d| Constraint {
+                terms: vec![(d, 1.0)],
+                value: 0.0,
+                label: format!("DOF {d}"),
+            })
+            .collect();
+        let reduction = Reduction::new(mesh.n_dofs(), &constraints).unwrap();
+        assert_eq!(reduction.n_eq(), dofs.n_eq());
+        // each order as the sequence of the DOFs its equations stand for
+        let mut dof_of_eq = vec![0; dofs.n_eq()];
+        let mut dof_of_q = vec![0; reduction.n_eq()];
+        for d in 0..mesh.n_dofs() {
+            if let Some(q) = dofs.eq(d) {
+                dof_of_eq[q] = d;
+                assert_eq!(reduction.row(d).len(), 1);
+                dof_of_q[reduction.row(d)[0].0] = d;
+            }
+        }
+        let kernel: Vec<usize> = nested_dissection(&mesh, &dofs)
+            .unwrap()
+            .iter()
+            .map(|&q| dof_of_eq[q])
+            .collect();
+        let reduced: Vec<usize> =
+            nested_dissection_reduced(mesh.n_nodes(), mesh.elements(), &reduction)
+                .unwrap()
+                .iter()
+                .map(|&q| dof_of_q[q])
+                .collect();
+        assert_eq!(kernel, reduced);
     }
 
     #[test]

@@ -13,6 +13,7 @@ use nalgebra::DMatrix;
 use super::assembly::SparseSym;
 use super::constraints::Reduction;
 use super::error::{FemError, Result};
+use super::ordering::nested_dissection_reduced;
 use super::solver::{CholeskyFactor, SymbolicFactor};
 
 /// The pattern of Tᵀ A T for elements with the given nodes (3 DOFs per node).
@@ -101,10 +102,7 @@ impl ReducedPattern {
         let with_rhs = reduction.has_offset();
         for (e, el) in elements.iter().enumerate() {
             let a = matrix(e)?;
-            let dofs: Vec<usize> = el
-                .iter()
-                .flat_map(|&n| (0..3).map(move |j| 3 * n + j))
-                .collect();
+            let dofs = element_dofs(el);
             for (i, &di) in dofs.iter().enumerate() {
                 let ri = reduction.row(di);
                 if ri.is_empty() {
@@ -140,14 +138,29 @@ impl ReducedPattern {
     }
 }
 
-/// The Cholesky factor of a reduced stiffness (approximate minimum degree order). A matrix that
-/// is not positive definite — supports that leave a rigid-body motion free — is refused.
-pub fn factorise(k: &SparseSym) -> Result<CholeskyFactor> {
+/// The Cholesky factor of a reduced stiffness `k` of the tetrahedra `elements` on `n_nodes`
+/// nodes, in nested-dissection order ([`nested_dissection_reduced`]). A matrix that is not
+/// positive definite — supports that leave a rigid-body motion free — is refused.
+pub fn factorise<E: AsRef<[usize]>>(
+    k: &SparseSym,
+    n_nodes: usize,
+    elements: &[E],
+    reduction: &Reduction,
+) -> Result<CholeskyFactor> {
     if k.n == 0 {
         return Err(FemError::InvalidInput("every DOF is constrained".into()));
     }
-    let symbolic = SymbolicFactor::analyse(k, None)?;
+    let order = nested_dissection_reduced(n_nodes, elements, reduction)?;
+    let symbolic = SymbolicFactor::analyse(k, Some(&order))?;
     CholeskyFactor::factorise(&symbolic, k)
+}
+
+/// The DOFs of an element's nodes, 3 per node.
+fn element_dofs(nodes: &[usize]) -> Vec<usize> {
+    nodes
+        .iter()
+        .flat_map(|&n| (0..3).map(move |j| 3 * n + j))
+        .collect()
 }
 
 /// Σ_e A_e u_e: the element matrices times the full vector `u`, summed per DOF (internal forces
@@ -161,10 +174,7 @@ pub fn element_product(
     let mut out = vec![0.0; n_dofs];
     for (e, el) in elements.iter().enumerate() {
         let a = matrix(e)?;
-        let dofs: Vec<usize> = el
-            .iter()
-            .flat_map(|&n| (0..3).map(move |j| 3 * n + j))
-            .collect();
+        let dofs = element_dofs(el);
         for (i, &di) in dofs.iter().enumerate() {
             out[di] += dofs
                 .iter()

@@ -1,18 +1,27 @@
 //! The lowest eigenpairs of K φ = λ B φ, K symmetric positive definite (factorised), B symmetric
 //! (the mass matrix M for natural frequencies, λ = ω²; −K_σ for linear buckling, λ the load
-//! factor; B may be indefinite), by inverse subspace iteration with Rayleigh–Ritz (K.-J. Bathe,
-//! *Finite Element Procedures*, 2nd ed., §11.6; the same iteration as [`super::buckling`]):
-//! with μ = 1/λ, a block X of q vectors,
+//! factor, [`super::buckling`]; B may be indefinite), by inverse subspace iteration with
+//! Rayleigh–Ritz (K.-J. Bathe, *Finite Element Procedures*, 2nd ed., §11.6): with μ = 1/λ, a
+//! block X of q vectors,
 //!
-//! 1. X̄ = K⁻¹ (B X) (one multi-right-hand-side solve with the factor);
-//! 2. K_r = X̄ᵀ K X̄ = X̄ᵀ (B X), B_r = X̄ᵀ B X̄;
-//! 3. B_r z = μ K_r z (K_r = L Lᵀ, the symmetric eigenproblem of L⁻¹ B_r L⁻ᵀ, nalgebra); X ← X̄ Z;
+//! 1. X̄ = K⁻¹ Y, Y = B X (one multi-right-hand-side solve with the factor; after the first
+//!    iteration Y is carried over as (B X̄) Z from step 3, Bathe §11.6.3, so that each iteration
+//!    multiplies by B once);
+//! 2. K_r = X̄ᵀ K X̄ = X̄ᵀ Y, B_r = X̄ᵀ B X̄;
+//! 3. B_r z = μ K_r z (K_r = L Lᵀ, the symmetric eigenproblem of L⁻¹ B_r L⁻ᵀ, nalgebra);
+//!    X ← X̄ Z, K-orthonormal, in descending μ;
 //!
 //! until the wanted p largest positive μ (the p smallest positive λ) each change by at most
-//! `tolerance` (relative) between iterations. The block has q = min(n, max(2p, p + 8)) vectors
-//! (Bathe's choice), started from B's diagonal pattern and the reference vector given.
+//! `tolerance` (relative) between iterations. The block converges to the eigenvalues of largest
+//! |μ| at the rate |μ_{q+1}/μ_i| per iteration; both signs occur when B is indefinite (a negative
+//! buckling factor is that of the reversed load). When the block holds no positive μ and its
+//! dominant negative one has settled, there is no positive λ within reach and the problem is
+//! refused. [`lowest_eigenpairs`] chooses the block (q = min(n, max(2p, p + 8)), Bathe's choice)
+//! and its start (a reference vector, B's diagonal, a fixed pseudo-random fill);
+//! [`subspace_iteration`] takes the caller's.
 
 use nalgebra::DMatrix;
+use rayon::prelude::*;
 
 use super::assembly::SparseSym;
 use super::error::{FemError, Result};
@@ -25,13 +34,21 @@ pub struct EigenPairs {
     pub values: Vec<f64>,
     /// φ_k (length n), K-orthonormal (φᵀ K φ = 1), i.e. B-normalised to φᵀ B φ = 1/λ.
     pub vectors: Vec<Vec<f64>>,
+    /// Every Ritz value of the last iteration as λ = 1/μ, in descending μ (the positive ones
+    /// first, the higher ones converged less than the wanted).
+    pub ritz: Vec<f64>,
     /// Iterations made.
     pub iterations: usize,
 }
 
+/// Y = A X for the `q` columns of `x` (column after column), in parallel over the columns.
 fn mul_block(a: &SparseSym, x: &[f64], q: usize) -> Vec<f64> {
     let n = a.n;
-    (0..q).flat_map(|k| a.mul(&x[k * n..(k + 1) * n])).collect()
+    let cols: Vec<Vec<f64>> = (0..q)
+        .into_par_iter()
+        .map(|k| a.mul(&x[k * n..(k + 1) * n]))
+        .collect();
+    cols.concat()
 }
 
 fn gram(a: &[f64], b: &[f64], n: usize, q: usize) -> DMatrix<f64> {
@@ -86,8 +103,34 @@ pub fn lowest_eigenpairs(
             x[k * n + i] = ((h >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * (1.0 + diag[i]);
         }
     }
+    subspace_iteration(factor, b, x, p, tolerance, max_iterations)
+}
+
+/// Ritz values μ below this fraction of the largest |μ| count as zero, not positive.
+const POSITIVE_FLOOR: f64 = 1e-9;
+
+/// The subspace iteration from the start block `x` (its q = `x.len() / n` columns one after
+/// the other): the `p` smallest positive λ of K φ = λ B φ, converged to `tolerance` (relative
+/// change of each between iterations).
+pub fn subspace_iteration(
+    factor: &CholeskyFactor,
+    b: &SparseSym,
+    mut x: Vec<f64>,
+    p: usize,
+    tolerance: f64,
+    max_iterations: usize,
+) -> Result<EigenPairs> {
+    let n = b.n;
+    if n == 0 || p == 0 || x.len() < n || !x.len().is_multiple_of(n) || max_iterations == 0 {
+        return Err(FemError::InvalidInput(format!(
+            "subspace iteration: a start block of {} entries for {n} DOFs and {p} eigenvalues",
+            x.len()
+        )));
+    }
+    let q = x.len() / n;
     let mut y = mul_block(b, &x, q);
     let mut previous: Vec<f64> = Vec::new();
+    let mut dominant_previous = f64::NAN;
     for it in 1..=max_iterations {
         let mut xb = y.clone();
         factor.solve_in_place(&mut xb, q);
@@ -134,10 +177,22 @@ pub fn lowest_eigenpairs(
         let scale = mus.iter().fold(0.0f64, |a, m| a.max(m.abs()));
         let lambdas: Vec<f64> = mus
             .iter()
-            .take_while(|m| **m > 1e-12 * scale)
+            .take_while(|m| **m > POSITIVE_FLOOR * scale)
             .take(p)
             .map(|m| 1.0 / m)
             .collect();
+        if lambdas.is_empty() {
+            // no positive Ritz value: stop once the block's dominant value has settled
+            let dominant = mus[q - 1];
+            if (dominant - dominant_previous).abs() <= tolerance * dominant.abs() {
+                return Err(FemError::InvalidInput(format!(
+                    "no positive eigenvalue: the {q} of largest magnitude are all negative, the \
+                     nearest λ = {:.4e}",
+                    1.0 / dominant
+                )));
+            }
+            dominant_previous = dominant;
+        }
         let converged = !lambdas.is_empty()
             && lambdas.len() == previous.len()
             && lambdas
@@ -151,6 +206,7 @@ pub fn lowest_eigenpairs(
             return Ok(EigenPairs {
                 values: lambdas,
                 vectors,
+                ritz: mus.iter().map(|m| 1.0 / m).collect(),
                 iterations: it,
             });
         }
