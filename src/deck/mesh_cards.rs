@@ -32,9 +32,12 @@ impl Model {
                     0.0
                 },
             ];
-            if self.node_index.insert(id, self.nodes.len()).is_some() {
+            // a node defined twice keeps its first definition (the refusal is listed with the
+            // deck's others, and its elements still find the node they name)
+            if self.node_index.contains_key(&id) {
                 return Err(error(path, d.line, format!("node {id} defined twice")));
             }
+            self.node_index.insert(id, self.nodes.len());
             added.push(self.nodes.len());
             self.node_ids.push(id);
             self.nodes.push(p);
@@ -137,9 +140,10 @@ impl Model {
                         }
                     }
                 }
-                if self.element_index.insert(id, self.elements.len()).is_some() {
+                if self.element_index.contains_key(&id) {
                     return Err(error(path, start, format!("element {id} defined twice")));
                 }
+                self.element_index.insert(id, self.elements.len());
                 added.push(self.elements.len());
                 self.elements.push(Element {
                     id,

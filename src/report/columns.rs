@@ -9,7 +9,7 @@
 
 use serde::{Serialize, Serializer};
 
-use super::ranking::{ROD_BODY_ALONE, RankRow, is_rod_body_alone};
+use super::rank_row::{ROD_BODY_ALONE, RankRow, Status, is_rod_body_alone};
 use crate::rod::LoadCaseResult;
 use crate::rod::cases::{LoadCase, STATIC_CASES};
 
@@ -379,7 +379,7 @@ pub const COLUMNS: &[Column] = &[
         shown: Shown::Always,
         cells: Cells::Design {
             csv: &[("error", |r| match &r.status {
-                super::ranking::Status::StageFailed { error, .. } => Value::Text(error.clone()),
+                Status::StageFailed { error, .. } => Value::Text(error.clone()),
                 _ => Value::Text(String::new()),
             })],
             table: None,

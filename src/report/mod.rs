@@ -11,6 +11,7 @@ pub mod mass_properties;
 pub mod pareto;
 pub mod picture;
 pub mod plots;
+pub mod rank_row;
 pub mod ranking;
 pub mod study_report;
 pub mod tables;

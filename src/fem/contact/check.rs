@@ -14,93 +14,13 @@
 
 use rayon::prelude::*;
 
+use super::acceptance::ContactCheck;
 use super::cylinder::PinMotion;
-use super::problem::{ContactProblem, ContactTolerances, Restraint};
+use super::problem::{ContactProblem, Restraint};
 use super::weights::Wall;
 use crate::fem::boundary::{cross, norm};
 use crate::fem::element::element_stiffness;
 use crate::fem::error::{FemError, Result};
-
-/// The figures of a check (all relative figures are ≥ 0).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct ContactCheck {
-    /// |r| at the free DOFs / |f + f_c|.
-    pub equilibrium_residual_rel: f64,
-    /// Largest |resultant − force| / |force| over the force-driven pins.
-    pub resultant_error_rel: f64,
-    /// Largest complementarity violation on the weighted gaps, relative to the largest
-    /// ∫ψ_b × gap scale.
-    pub complementarity_rel: f64,
-    /// Largest penetration, m.
-    pub penetration_max_m: f64,
-    /// Largest penetration / gap scale.
-    pub penetration_rel: f64,
-    /// Largest tensile pressure (max −λ, 0 if none), Pa.
-    pub max_tensile_pressure_pa: f64,
-    /// The free-motion support's reaction, relative ([`Restraint::reaction_rel`]).
-    pub free_mode_reaction_rel: f64,
-    /// The gap scale: the largest initial gap or radial motion of a wall node relative to its
-    /// pin, m.
-    pub gap_scale_m: f64,
-    /// The load scale: Σ_b |λ_b c_b| (every wall node's contact force) + |Σ other loads|, N.
-    pub load_scale_n: f64,
-}
-
-impl ContactCheck {
-    /// Refuses a solution outside `tol`.
-    pub fn verify(&self, tol: &ContactTolerances) -> Result<()> {
-        let mut bad = Vec::new();
-        if !within(self.equilibrium_residual_rel, tol.complementarity_rel) {
-            bad.push(format!(
-                "equilibrium residual {:.2e} > {:.0e}",
-                self.equilibrium_residual_rel, tol.complementarity_rel
-            ));
-        }
-        if !within(self.resultant_error_rel, tol.resultant_rel) {
-            bad.push(format!(
-                "pin force resultant error {:.2e} > {:.0e}",
-                self.resultant_error_rel, tol.resultant_rel
-            ));
-        }
-        if !within(self.complementarity_rel, tol.complementarity_rel) {
-            bad.push(format!(
-                "complementarity violation {:.2e} > {:.0e}",
-                self.complementarity_rel, tol.complementarity_rel
-            ));
-        }
-        if !within(self.penetration_rel, tol.penetration_rel) {
-            bad.push(format!(
-                "penetration {:.3e} m = {:.2e} of the gap scale > {:.0e}",
-                self.penetration_max_m, self.penetration_rel, tol.penetration_rel
-            ));
-        }
-        if !within(self.max_tensile_pressure_pa, 0.0) {
-            bad.push(format!(
-                "tensile contact pressure {:.3e} Pa",
-                self.max_tensile_pressure_pa
-            ));
-        }
-        if let Some(t) = tol.free_mode_reaction_rel
-            && !within(self.free_mode_reaction_rel, t)
-        {
-            bad.push(format!(
-                "the support of the free motions carries {:.2e} of the load (> {t:.0e}): the \
-                 loads are not in balance about the pin that holds the body",
-                self.free_mode_reaction_rel
-            ));
-        }
-        if bad.is_empty() {
-            Ok(())
-        } else {
-            Err(FemError::Check(format!("contact: {}", bad.join("; "))))
-        }
-    }
-}
-
-/// v ≤ limit, false for NaN.
-fn within(v: f64, limit: f64) -> bool {
-    v <= limit
-}
 
 /// Checks the displacements `u` (3 per node), the wall pressures `pressure` (per cylinder, per
 /// wall node, Pa) and the pin translations `pins` (m) of `problem`, with the support of the free

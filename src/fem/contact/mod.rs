@@ -15,6 +15,7 @@
 //!
 //! See `docs/contact.md` for the formulation, the verification and the cost.
 
+pub mod acceptance;
 pub mod check;
 pub mod compliance;
 pub mod cylinder;
@@ -25,7 +26,8 @@ pub mod problem;
 pub mod solve;
 pub mod weights;
 
-pub use check::{ContactCheck, check};
+pub use acceptance::ContactCheck;
+pub use check::check;
 pub use cylinder::{Cylinder, PinMotion};
 pub use measures::{DiameterChange, diameter_change};
 pub use problem::{

@@ -1,6 +1,6 @@
 //! What a contact solve takes and what it gives back.
 
-use super::check::ContactCheck;
+pub use super::acceptance::{ContactCheck, ContactTolerances};
 use super::cylinder::Cylinder;
 use crate::fem::element::QuadratureChoice;
 use crate::fem::material::Material;
@@ -24,35 +24,6 @@ pub struct ContactProblem<'a> {
     pub cylinders: Vec<Cylinder>,
     /// Acceptance limits of the solution.
     pub tolerances: ContactTolerances,
-}
-
-/// Limits a solution must meet, else the solve is refused ([`super::check`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ContactTolerances {
-    /// Largest penetration of a wall node into its pin, relative to the gap scale (the largest
-    /// initial gap or radial displacement of a wall node relative to its pin).
-    pub penetration_rel: f64,
-    /// |Σ contact forces of a force-driven pin − its force| / |force|.
-    pub resultant_rel: f64,
-    /// Weighted gaps recomputed from the displacement: |G| on the active rows and −G on the
-    /// inactive ones, relative to the largest |free gap|; and the residual of K u = f.
-    pub complementarity_rel: f64,
-    /// The reaction of the support that holds the motions contact leaves free (rotation about
-    /// a lone fixed pin, sliding along it), relative to the load scale (force) and the load
-    /// scale × body size (moment). `None`: reported, not enforced (loads that are not in
-    /// balance about the pin, e.g. a transverse pin force without the body's inertia).
-    pub free_mode_reaction_rel: Option<f64>,
-}
-
-impl Default for ContactTolerances {
-    fn default() -> Self {
-        ContactTolerances {
-            penetration_rel: 0.05,
-            resultant_rel: 1e-10,
-            complementarity_rel: 1e-8,
-            free_mode_reaction_rel: Some(1e-8),
-        }
-    }
 }
 
 /// The contact on one cylinder.
