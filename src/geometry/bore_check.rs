@@ -132,15 +132,7 @@ impl<'a> RodSurface<'a> {
 
     /// The ray casts from `centre`: containment, the axis line both ways, the in-plane rays.
     pub fn probe(&self, centre: Vector3<f64>, axis: Vector3<f64>) -> BoreProbe {
-        let axis = axis.normalize();
-        let u = axis
-            .cross(&if axis.x.abs() < 0.9 {
-                Vector3::x()
-            } else {
-                Vector3::y()
-            })
-            .normalize();
-        let v = axis.cross(&u);
+        let (axis, u, v) = plane_basis(axis);
         // one pass: the triangles the axis line (and the slightly tilted containment rays) can
         // meet, and those across the plane
         let margin = 1e-3 * self.extent;
@@ -205,15 +197,7 @@ pub fn first_in_plane_hits(
     centre: Vector3<f64>,
     axis: Vector3<f64>,
 ) -> Vec<u32> {
-    let axis = axis.normalize();
-    let u = axis
-        .cross(&if axis.x.abs() < 0.9 {
-            Vector3::x()
-        } else {
-            Vector3::y()
-        })
-        .normalize();
-    let v = axis.cross(&u);
+    let (axis, u, v) = plane_basis(axis);
     let across_plane: Vec<u32> = (0..mesh.triangles.len() as u32)
         .filter(|&t| {
             let ws = mesh.corners(t as usize).map(|p| (p - centre).dot(&axis));
@@ -275,6 +259,21 @@ impl BoreProbe {
     pub fn open_share(&self) -> f64 {
         self.in_plane.iter().filter(|h| h.is_none()).count() as f64 / self.in_plane.len() as f64
     }
+}
+
+/// The unit `axis` and two unit vectors u, v across it (a right-handed frame u, v, axis: u ⟂ the
+/// axis and the coordinate axis least aligned with it).
+fn plane_basis(axis: Vector3<f64>) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+    let axis = axis.normalize();
+    let u = axis
+        .cross(&if axis.x.abs() < 0.9 {
+            Vector3::x()
+        } else {
+            Vector3::y()
+        })
+        .normalize();
+    let v = axis.cross(&u);
+    (axis, u, v)
 }
 
 #[cfg(test)]
