@@ -26,7 +26,13 @@
 //! singular_band_mm = 3.0       # band around sharp re-entrant edges left out of it
 //! youngs_modulus_pa = 210e9
 //! poisson_ratio = 0.3
-//! bore_load = "uniform"        # or "cosine": a cosine bearing pressure on the pressed half
+//! bore_load = "uniform"        # or "cosine": a cosine bearing pressure on the pressed half;
+//!                              # or "contact": frictionless contact with rigid pins
+//! clearance_a_mm = 0.0175      # contact: radial clearance of the crank pin in bore A
+//!                              # (negative: interference); default 0.35 ‰ of the bore diameter
+//! clearance_b_mm = 0.00875     # contact: the piston pin's in bore B; same default
+//! load_model_error = true      # solve the other load models on the final mesh (the error bar's
+//!                              # load-model part)
 //!
 //! [criterion]         # the ranking's stress criterion
 //! yield_mpa = 355.0
@@ -123,6 +129,19 @@ pub struct FemConfig {
     /// written into `results.json`.
     #[serde(skip_serializing_if = "BoreLoad::is_uniform")]
     pub bore_load: BoreLoad,
+    /// With `bore_load = "contact"` and for the load-model comparison: the radial clearance of the
+    /// crank pin in bore A, mm (negative: an interference); absent: 0.35 ‰ of the bore's
+    /// diameter ([`crate::rod::bores::default_clearance_m`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clearance_a_mm: Option<f64>,
+    /// The same for the piston pin in bore B, mm.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clearance_b_mm: Option<f64>,
+    /// Solve the judged cases on the final mesh under the other load models too (uniform, cosine
+    /// and contact): the load-model part of each case's error bar
+    /// (`estimated_load_model_error_rel`). The default is not written into `results.json`.
+    #[serde(skip_serializing_if = "is_true")]
+    pub load_model_error: bool,
     /// `"auto"` (default): an STL rod symmetric about its mid-plane across the pin axis (within
     /// [`crate::stages::fem::MIRROR_TOLERANCE_MM`]) is meshed and solved as its half with
     /// u_z = 0 on the plane, then mirrored (the same answer on the same mesh, from half the
@@ -164,6 +183,10 @@ impl Symmetry {
 /// `bench fem --adaptive`): `1` as `"auto"`, `0` as `"off"`.
 pub const HALF_MODEL_VAR: &str = "RODSTUDY_HALF_MODEL";
 
+fn is_true(v: &bool) -> bool {
+    *v
+}
+
 impl FemConfig {
     /// The default of `step_min_size_mm`.
     pub const STEP_MIN_SIZE_MM: f64 = 0.1;
@@ -189,6 +212,9 @@ impl Default for FemConfig {
             youngs_modulus_pa: 210e9,
             poisson_ratio: 0.3,
             bore_load: BoreLoad::Uniform,
+            clearance_a_mm: None,
+            clearance_b_mm: None,
+            load_model_error: true,
             symmetry: Symmetry::Auto,
         }
     }
@@ -391,6 +417,18 @@ impl StudyConfig {
         for (key, v) in positive {
             if !(v.is_finite() && v > 0.0) {
                 bail!("`{key}` must be a positive number, got {v}");
+            }
+        }
+        for (key, c) in [
+            ("fem.clearance_a_mm", self.fem.clearance_a_mm),
+            ("fem.clearance_b_mm", self.fem.clearance_b_mm),
+        ] {
+            if let Some(c) = c
+                && !(c.is_finite() && c.abs() < 1.0)
+            {
+                bail!(
+                    "`{key}` must be a radial clearance under 1 mm (negative: an interference), got {c} mm"
+                );
             }
         }
         check_upper_bounds(&[

@@ -111,5 +111,6 @@ fn mirrored_static<'a>(
         loads,
         sol,
         system: None,
+        contact: half.contact.into_iter().map(|c| c.mirrored(m)).collect(),
     })
 }

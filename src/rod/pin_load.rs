@@ -1,7 +1,8 @@
-//! How a pin's force enters its bore: the two spreads of `[fem] bore_load` as nodal forces on the
-//! bore's faces, over the kernel's surface loads ([`crate::fem::load`]).
+//! How a pin's force enters its bore (`[fem] bore_load`): the two prescribed spreads as nodal forces
+//! on the bore's faces, over the kernel's surface loads ([`crate::fem::load`]), or contact with the
+//! pin, which is solved, not prescribed ([`super::contact_cases`]).
 //!
-//! A pin's force on its bore is spread in one of two ways ([`BoreLoad`], `[fem] bore_load`):
+//! A prescribed spread of a pin's force on its bore ([`BoreLoad`]) is one of:
 //! - **uniform** (the thesis' setting and the default): a constant traction of resultant F over the
 //!   whole bore wall, [`uniform_traction_with_resultant`];
 //! - **cosine**: a pressure normal to the pin's cylinder over the half of the bore the pin presses
@@ -31,6 +32,9 @@ pub enum BoreLoad {
     Uniform,
     /// A cosine pressure over the half of the bore the pin presses on.
     Cosine,
+    /// Frictionless contact with a rigid pin of the bore's radius less the clearance
+    /// ([`super::contact_cases`]): the arc and the pressure follow from the solve.
+    Contact,
 }
 
 impl BoreLoad {
@@ -44,12 +48,24 @@ impl BoreLoad {
         match self {
             BoreLoad::Uniform => "uniform",
             BoreLoad::Cosine => "cosine",
+            BoreLoad::Contact => "contact",
+        }
+    }
+
+    /// The load a linear, superposable analysis uses for this one: contact's closest prescribed
+    /// spread is the cosine pressure on the pressed half (the arc of a pin with small clearance;
+    /// docs/contact.md), the others are themselves.
+    pub fn linear(self) -> BoreLoad {
+        match self {
+            BoreLoad::Contact => BoreLoad::Cosine,
+            other => other,
         }
     }
 }
 
 /// The nodal forces of the pin force `resultant` (N) on the bore `faces` around the pin axis
-/// through `centre` (m) with unit direction `axis`, spread as `kind` says.
+/// through `centre` (m) with unit direction `axis`, spread as `kind` says; contact, which is not a
+/// prescribed spread, as its linear stand-in ([`BoreLoad::linear`]).
 pub fn pin_load(
     mesh: &TetMesh,
     faces: &[[usize; 6]],
@@ -58,9 +74,9 @@ pub fn pin_load(
     resultant: [f64; 3],
     kind: BoreLoad,
 ) -> Result<SurfaceLoad> {
-    match kind {
+    match kind.linear() {
         BoreLoad::Uniform => uniform_traction_with_resultant(mesh, faces, resultant),
-        BoreLoad::Cosine => cosine_pressure_with_resultant(mesh, faces, centre, axis, resultant),
+        _ => cosine_pressure_with_resultant(mesh, faces, centre, axis, resultant),
     }
 }
 

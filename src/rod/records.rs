@@ -88,6 +88,18 @@ pub struct LoadCaseResult {
     /// (see `estimated_geometry_error_rel`), MPa.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub smooth_surface_peak_mpa: Option<f64>,
+    /// The load-model part: how far the judged peak of the thesis' uniform traction is from that
+    /// of contact with the pins (the most faithful of the load models, at the clearances of
+    /// `load_models.contact`), |P_uniform − P_contact| / P_contact on the final mesh; `None` where
+    /// the comparison was not made (`[fem] load_model_error = false`, a command on one mesh).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub estimated_load_model_error_rel: Option<f64>,
+    /// The judged peak of this case on the final mesh under each load model.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub load_models: Option<LoadModelPeaks>,
+    /// With contact (`[fem] bore_load = "contact"`): the pins' contact in this case.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact: Option<PinContactRecord>,
     /// The recovery-based (Zienkiewicz–Zhu) estimates on this mesh.
     pub error_estimate: EstimateSummary,
     /// The adaptive sequence that led to this mesh (empty for a fixed mesh).
@@ -108,8 +120,98 @@ impl LoadCaseResult {
     pub fn set_error_bar(&mut self, discretisation: f64, geometry: Option<f64>) {
         self.estimated_discretisation_error_rel = discretisation;
         self.estimated_geometry_error_rel = geometry;
-        self.estimated_error_rel = discretisation + geometry.unwrap_or(0.0);
+        self.sum_error_bar();
     }
+
+    /// The load-model part of the error bar ([`Self::estimated_load_model_error_rel`]) with the
+    /// peaks it comes from; the sum ε = ε_disc + ε_geom + ε_load (a bound, as in
+    /// [`Self::set_error_bar`]).
+    pub fn set_load_model_error(&mut self, peaks: LoadModelPeaks) {
+        self.estimated_load_model_error_rel = Some(peaks.error_rel());
+        self.load_models = Some(peaks);
+        self.sum_error_bar();
+    }
+
+    fn sum_error_bar(&mut self) {
+        self.estimated_error_rel = self.estimated_discretisation_error_rel
+            + self.estimated_geometry_error_rel.unwrap_or(0.0)
+            + self.estimated_load_model_error_rel.unwrap_or(0.0);
+    }
+
+    /// Which part of the error bar is largest: `"discretisation"`, `"geometry"` or `"load model"`.
+    pub fn dominant_error(&self) -> &'static str {
+        let parts = [
+            ("discretisation", self.estimated_discretisation_error_rel),
+            ("geometry", self.estimated_geometry_error_rel.unwrap_or(0.0)),
+            (
+                "load model",
+                self.estimated_load_model_error_rel.unwrap_or(0.0),
+            ),
+        ];
+        parts
+            .iter()
+            .fold(parts[0], |a, b| if b.1 > a.1 { *b } else { a })
+            .0
+    }
+}
+
+/// One case's judged peak (max nodally averaged von Mises away from bore B and the sharp edges,
+/// MPa) on the final mesh under each load model: the uniform traction (the thesis'), the cosine
+/// bearing pressure and contact with rigid pins (with its record).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct LoadModelPeaks {
+    pub uniform_mpa: f64,
+    pub cosine_mpa: f64,
+    pub contact_mpa: f64,
+    /// Where the contact peak is, mm.
+    pub contact_at_mm: [f64; 3],
+    /// The pins' contact.
+    pub contact: PinContactRecord,
+}
+
+impl LoadModelPeaks {
+    /// |P_uniform − P_contact| / P_contact.
+    pub fn error_rel(&self) -> f64 {
+        (self.uniform_mpa - self.contact_mpa).abs() / self.contact_mpa
+    }
+
+    /// (P_cosine − P_contact) / P_contact.
+    pub fn cosine_vs_contact_rel(&self) -> f64 {
+        (self.cosine_mpa - self.contact_mpa) / self.contact_mpa
+    }
+}
+
+/// The contact of the pins with their bores in one case: arcs (degrees about the pin axis, from
+/// the contact resultant's direction), peak pressures (face-smoothed, MPa), the big-end bore's
+/// change of diameter, the acceptance figures.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct PinContactRecord {
+    /// Radial clearances of pins A and B in their bores, µm (negative: interference).
+    pub clearance_a_um: f64,
+    pub clearance_b_um: f64,
+    /// The contact arc on bore A and its ends.
+    pub arc_a_deg: f64,
+    pub arc_a_ends_deg: [f64; 2],
+    pub peak_pressure_a_mpa: f64,
+    /// Where the peak pressure is, from the resultant's direction.
+    pub peak_pressure_a_at_deg: f64,
+    /// The same on bore B; `None` where bore B is clamped (a force across the rod).
+    pub arc_b_deg: Option<f64>,
+    pub peak_pressure_b_mpa: Option<f64>,
+    /// Bore A's change of diameter along the pin force and across it, µm.
+    pub ovality_a_along_um: f64,
+    pub ovality_a_across_um: f64,
+    /// Largest penetration of a wall node into its pin, µm.
+    pub penetration_max_um: f64,
+    /// Largest tensile contact pressure (0: none), MPa.
+    pub max_tensile_pressure_mpa: f64,
+    /// |moment| of the support of the rotation that frictionless contact leaves free, N·m (~0).
+    pub restraint_moment_nm: f64,
+    /// Active-set iterations.
+    pub iterations: usize,
+    /// Wall time of the solve, s (not in `results.json`).
+    #[serde(skip)]
+    pub seconds: f64,
 }
 
 /// One iteration of the adaptive loop, for one load case.

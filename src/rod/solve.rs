@@ -14,11 +14,12 @@ use serde::{Deserialize, Serialize};
 
 use super::bores::{BoreSpec, BoreSurface, find_bores};
 use super::cases::STATIC_CASES;
+use super::contact_cases::{ContactCase, contact_static};
 use super::judged::{
     Bands, DEFAULT_FIXED_BAND_M, DEFAULT_SINGULAR_BAND_M, edge_band_warning, judged_nodes,
     singularity_floor,
 };
-use super::pin_load::pin_load;
+use super::pin_load::{BoreLoad, pin_load};
 use super::records::{FemResult, LoadCaseResult, LoadCases};
 use crate::fem::boundary::{boundary_faces, norm};
 use crate::fem::element::QuadratureChoice;
@@ -111,6 +112,17 @@ pub struct RodSolution {
     /// the node of the half it is or is the image of (the first `half_model.nodes` are the half's
     /// own).
     pub mirror_source: Option<Vec<usize>>,
+    /// With contact: per case, the contact pressure and gap at each node (empty otherwise).
+    pub contact_fields: Vec<ContactFields>,
+}
+
+/// The nodal fields of one case's contact ([`super::contact_cases::ContactCase`]).
+#[derive(Clone, Debug)]
+pub struct ContactFields {
+    /// Contact pressure (face-smoothed; 0 off the bore walls), Pa.
+    pub pressure_pa: Vec<f64>,
+    /// Gap between a bore wall and its pin (0 off the bore walls), m.
+    pub gap_m: Vec<f64>,
 }
 
 /// Analyses a rod: see the module documentation. `force_n` > 0 is the pin force of the cases
@@ -156,6 +168,8 @@ pub struct RodStatic<'a> {
     pub(super) loads: Vec<SurfaceLoad>,
     pub(super) sol: StaticSolution,
     pub(super) system: Option<Arc<FactorisedSystem>>,
+    /// With contact ([`BoreLoad::Contact`]): each case's contact ([`super::contact_cases`]).
+    pub(super) contact: Vec<ContactCase>,
 }
 
 /// The bores, loads and static solution of the cases ([`RodStatic`]).
@@ -196,6 +210,19 @@ pub(super) fn static_cases<'a>(
         })
         .collect::<Result<Vec<_>>>()?;
     check_one_piece(mesh, &fixed.nodes)?;
+    if bores.bore_load == BoreLoad::Contact {
+        return contact_static(
+            mesh,
+            material,
+            bores,
+            options,
+            cases,
+            (loaded, fixed, axis),
+            load_share,
+            held,
+            t_all,
+        );
+    }
     let loads = cases
         .iter()
         .map(|(d, f)| {
@@ -246,6 +273,7 @@ pub(super) fn static_cases<'a>(
         loads,
         sol,
         system,
+        contact: Vec::new(),
     })
 }
 
@@ -264,6 +292,7 @@ pub fn rod_fields(st: RodStatic<'_>, options: &RodOptions) -> Result<RodSolution
         loads,
         sol,
         system,
+        contact,
     } = st;
     let (material, bores) = (&material, &bores);
     let t_stress = Instant::now();
@@ -350,6 +379,9 @@ pub fn rod_fields(st: RodStatic<'_>, options: &RodOptions) -> Result<RodSolution
             adaptive: Vec::new(),
             vtu: None,
             picture: None,
+            estimated_load_model_error_rel: None,
+            load_models: None,
+            contact: contact.get(c).map(|cc| cc.record.clone()),
         };
         case.set_error_bar(estimate.summary.single_mesh_estimate(), None);
         results.push(case);
@@ -395,6 +427,13 @@ pub fn rod_fields(st: RodStatic<'_>, options: &RodOptions) -> Result<RodSolution
         buckling: None,
         system,
         mirror_source: None,
+        contact_fields: contact
+            .into_iter()
+            .map(|c| ContactFields {
+                pressure_pa: c.pressure_pa,
+                gap_m: c.gap_m,
+            })
+            .collect(),
     })
 }
 

@@ -24,15 +24,16 @@ use crate::fem::error::{FemError, Result};
 
 /// Checks the displacements `u` (3 per node), the wall pressures `pressure` (per cylinder, per
 /// wall node, Pa) and the pin translations `pins` (m) of `problem`, with the support of the free
-/// motions on `support` (DOFs). Returns the figures and the support's reaction; it does not
-/// judge them ([`ContactCheck::verify`] does).
+/// motions on `support` (DOFs). Returns the figures, the support's reaction and the reactions
+/// K u − f − f_c at the prescribed DOFs and the support's (3 per node, zero elsewhere); it does
+/// not judge them ([`ContactCheck::verify`] does).
 pub fn check(
     problem: &ContactProblem,
     u: &[f64],
     pressure: &[Vec<f64>],
     pins: &[[f64; 3]],
     support: &[usize],
-) -> Result<(ContactCheck, Restraint)> {
+) -> Result<(ContactCheck, Restraint, Vec<f64>)> {
     let mesh = problem.mesh;
     let n = mesh.n_dofs();
     if u.len() != n || pressure.len() != problem.cylinders.len() || pins.len() != pressure.len() {
@@ -122,9 +123,12 @@ pub fn check(
         held[d] = true;
     }
     let (mut num, mut den) = (0.0, 0.0);
+    let mut reactions = vec![0.0; n];
     for d in 0..n {
         den += f[d] * f[d];
-        if !held[d] {
+        if held[d] {
+            reactions[d] = r[d] - f[d];
+        } else {
             num += (r[d] - f[d]).powi(2);
         }
     }
@@ -159,6 +163,7 @@ pub fn check(
             point_m: point,
             reaction_rel,
         },
+        reactions,
     ))
 }
 

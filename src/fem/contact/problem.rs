@@ -102,6 +102,12 @@ pub struct ContactTimings {
 pub struct ContactSolution {
     /// Displacements, 3 per node (m): for [`crate::fem::stress::stress_field`].
     pub displacements: Vec<f64>,
+    /// The contact forces of each cylinder on the body, 3 per node (N; zero off its wall), in
+    /// the problem's order: the consistent nodal forces of its pressures.
+    pub contact_forces: Vec<Vec<f64>>,
+    /// Reactions K u − f − f_c at the prescribed DOFs and the free-motion support's DOFs, 3 per
+    /// node (N; zero elsewhere), as [`crate::fem::statics::StaticSolution::reactions`].
+    pub reactions: Vec<f64>,
     /// Per cylinder, in the problem's order.
     pub cylinders: Vec<CylinderContact>,
     /// The support of the free motions.

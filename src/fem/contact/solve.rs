@@ -332,7 +332,16 @@ pub fn solve_contact(problem: &ContactProblem) -> Result<ContactSolution> {
             None => [0.0; 3],
         })
         .collect();
-    let (chk, mut restraint) = check(problem, &u, &pressures, &pins, &fl.support)?;
+    let contact_forces: Vec<Vec<f64>> = walls
+        .iter()
+        .zip(&pressures)
+        .map(|(w, lam)| {
+            let mut fc = vec![0.0; n];
+            w.add_forces(lam, &mut fc);
+            fc
+        })
+        .collect();
+    let (chk, mut restraint, reactions) = check(problem, &u, &pressures, &pins, &fl.support)?;
     restraint.free_motions = free_motions;
     let cylinders = walls
         .iter()
@@ -344,6 +353,8 @@ pub fn solve_contact(problem: &ContactProblem) -> Result<ContactSolution> {
     chk.verify(&problem.tolerances)?;
     Ok(ContactSolution {
         displacements: u,
+        contact_forces,
+        reactions,
         cylinders,
         restraint,
         check: chk,

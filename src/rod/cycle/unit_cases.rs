@@ -183,7 +183,7 @@ fn unit_solutions_with(
         }
     };
     let mut loads = Vec::with_capacity(6);
-    let pin = match bores.bore_load {
+    let pin = match bores.bore_load.linear() {
         BoreLoad::Uniform => {
             for d in [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
                 loads.push(uniform_traction_with_resultant(mesh, &loaded.faces, d)?.forces);
@@ -191,7 +191,7 @@ fn unit_solutions_with(
             body(&mut loads);
             PinBasis::Linear
         }
-        BoreLoad::Cosine => {
+        BoreLoad::Cosine | BoreLoad::Contact => {
             body(&mut loads);
             let step_deg = options.direction_step_deg;
             let n = directions_of(step_deg)?;

@@ -20,7 +20,7 @@
 //! against `[criterion] buckling_factor`; without a trace the default study does not (its results
 //! stay as they were). `rodstudy fem` always reports it.
 
-use super::criterion::judge_buckling;
+use super::criterion::{judge_buckling, verdict};
 use super::records::{DesignDynamics, DesignFem, LoadedDesign, StageMesh};
 use crate::config::{FemConfig, StudyConfig};
 use crate::fem::buckling::{BucklingMode, BucklingOptions, BucklingSolution};
@@ -28,6 +28,7 @@ use crate::fem::statics::FactorisedSystem;
 use crate::fem::{Material, TetMesh};
 use crate::geometry::design::DesignMass;
 use crate::rod::buckling::rod_buckling;
+use crate::rod::load_models::compare_load_models;
 use crate::rod::solve::RodSolution;
 use crate::rod::{BoreSpec, RodOptions};
 use anyhow::{Context, Result};
@@ -98,6 +99,9 @@ pub struct FemOutcome {
     /// The buckling analysis [`fem_and_buckling`] ran beside the geometry check, not yet applied
     /// to the record ([`apply_buckling`]); `None` when none was asked for.
     pub buckling_run: Option<BucklingRun>,
+    /// The contact solution of the load-model comparison on the whole mesh, for the report's
+    /// fields (`None`: not compared, or the solution is itself contact's).
+    pub contact: Option<(TetMesh, RodSolution)>,
 }
 
 /// A buckling analysis of stage 3's final mesh under `compression_n` (N), and what came of it.
@@ -152,6 +156,10 @@ pub fn fem_and_buckling(
             Ok(outcome)
         }
     }?;
+    if config.fem.load_model_error {
+        add_load_model_error(&mut outcome, loads, config)
+            .with_context(|| format!("{}: the load model's error", design.file.display()))?;
+    }
     if engine {
         let run = outcome
             .buckling_run
@@ -168,6 +176,42 @@ pub fn fem_and_buckling(
         outcome.solution.system = None;
     }
     Ok(outcome)
+}
+
+/// The load model's part of each case's error bar ([`crate::rod::load_models`]): the cases solved
+/// on the final mesh under the other load models, ε_load into the record and the solution, the
+/// verdict judged again with it; the contact solution's fields kept for the report.
+fn add_load_model_error(
+    outcome: &mut FemOutcome,
+    loads: &FemLoads,
+    config: &StudyConfig,
+) -> Result<()> {
+    let stage = &outcome.mesh;
+    let options = RodOptions {
+        fixed_band_m: Some(stage.fixed_band_m),
+        singular_band_m: Some(stage.singular_band_m),
+        singular_edges_m: stage.singular_edges_m.clone(),
+        fy_force_n: loads.transverse_n,
+        ..RodOptions::default()
+    };
+    let compared = compare_load_models(
+        &stage.mesh,
+        &outcome.solution,
+        &Material::from(&config.fem),
+        &stage.bores,
+        loads.force_n,
+        &options,
+    )?;
+    for (c, peaks) in compared.peaks.into_iter().enumerate() {
+        outcome.record.fem.cases.0[c].set_load_model_error(peaks.clone());
+        outcome.solution.result.cases.0[c].set_load_model_error(peaks);
+    }
+    let b = stage.bores.fixed_centre_m;
+    let a = stage.bores.loaded_centre_m;
+    let centre_distance_mm = 1e3 * (0..3).map(|j| (b[j] - a[j]).powi(2)).sum::<f64>().sqrt();
+    outcome.record.criterion = verdict(&outcome.record.fem, config, centre_distance_mm);
+    outcome.contact = compared.contact;
+    Ok(())
 }
 
 /// A mesher failure on an STL whose facets cross each other says so first (gmsh's own words,

@@ -97,6 +97,8 @@ impl Setup {
         let mut bores = surface.bores();
         [bores.loaded_arc_deg, bores.fixed_arc_deg] = loads.bore_arcs_deg;
         bores.bore_load = config.fem.bore_load;
+        bores.clearance_a_m = config.fem.clearance_a_mm.map(|c| c * 1e-3);
+        bores.clearance_b_m = config.fem.clearance_b_mm.map(|c| c * 1e-3);
         Ok(Setup {
             step,
             bores,
@@ -216,6 +218,7 @@ impl Setup {
             },
             solution,
             buckling_run: None,
+            contact: None,
         }
     }
 
