@@ -2,6 +2,7 @@
 //! are ratios that travel between machines better than seconds.
 
 pub mod contact;
+pub mod contact_cycle;
 pub mod fem_adaptive;
 pub mod fem_convergence;
 pub mod fem_mesh;

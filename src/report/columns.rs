@@ -253,6 +253,47 @@ pub const COLUMNS: &[Column] = &[
         },
     },
     Column {
+        key: "load_model",
+        shown: Shown::Always,
+        cells: Cells::PerCase {
+            csv: &[
+                ("load_model_error_rel", |c| {
+                    Value::Num(c.and_then(|c| c.estimated_load_model_error_rel))
+                }),
+                ("contact_von_mises_mpa", |c| {
+                    Value::Num(c.and_then(|c| c.load_models.as_ref().map(|m| m.contact_mpa)))
+                }),
+                ("cosine_von_mises_mpa", |c| {
+                    Value::Num(c.and_then(|c| c.load_models.as_ref().map(|m| m.cosine_mpa)))
+                }),
+                ("uniform_von_mises_mpa", |c| {
+                    Value::Num(c.and_then(|c| c.load_models.as_ref().map(|m| m.uniform_mpa)))
+                }),
+                ("largest_error_part", |c| {
+                    Value::Text(c.map_or_else(String::new, |c| c.dominant_error().to_string()))
+                }),
+            ],
+            table: Some((
+                "σ ",
+                " contact / cosine / uniform [MPa]; ε_load; largest part",
+                |c| {
+                    let Some(c) = c else { return dash() };
+                    match (&c.load_models, c.estimated_load_model_error_rel) {
+                        (Some(m), Some(e)) => format!(
+                            "{:.1} / {:.1} / {:.1}; {:.1} %; {}",
+                            m.contact_mpa,
+                            m.cosine_mpa,
+                            m.uniform_mpa,
+                            100.0 * e,
+                            c.dominant_error()
+                        ),
+                        _ => format!("not compared; {}", c.dominant_error()),
+                    }
+                },
+            )),
+        },
+    },
+    Column {
         key: "cycle_max",
         shown: Shown::Always,
         cells: Cells::Design {
@@ -394,6 +435,7 @@ pub const TABLE: &[&str] = &[
     "status",
     "safety_factor",
     "stress",
+    "load_model",
     "cycle_max",
     "fatigue",
     "buckling",

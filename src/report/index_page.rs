@@ -237,6 +237,15 @@ fn design_section(s: &mut String, r: &RankRow, out: &Path) {
                 }
             ),
         ));
+        for case in f.fem.cases.iter() {
+            if let Some(k) = case
+                .contact
+                .as_ref()
+                .or(case.load_models.as_ref().map(|m| &m.contact))
+            {
+                props.push(("pin contact", contact_line(case, k)));
+            }
+        }
         for w in &f.fem.warnings {
             props.push(("FEM warning", w.clone()));
         }
@@ -331,6 +340,19 @@ fn design_section(s: &mut String, r: &RankRow, out: &Path) {
             );
         }
     }
+    if let Some(f) = r.fem {
+        for case in f.fem.cases.iter() {
+            image(
+                s,
+                out,
+                &format!("{dir}/contact_{}.svg", case.name),
+                &format!(
+                    "{} case: the contact pressure around the crank-pin bore (frictionless contact with a rigid pin at its clearance) against the cosine bearing pressure and the uniform traction of the same force",
+                    crate::rod::cases::label(&case.name)
+                ),
+            );
+        }
+    }
     if r.cycle.is_some() {
         image(
             s,
@@ -359,6 +381,8 @@ fn design_section(s: &mut String, r: &RankRow, out: &Path) {
         ),
         ("fem_fx.vtu", "F_x field (ParaView)", fem),
         ("fem_fy.vtu", "F_y field (ParaView)", fem),
+        ("contact_fx.vtu", "F_x under pin contact (ParaView)", fem),
+        ("contact_fy.vtu", "F_y under pin contact (ParaView)", fem),
         (
             "cycle.vtu",
             "max over the cycle and fatigue factor (ParaView)",
@@ -373,6 +397,30 @@ fn design_section(s: &mut String, r: &RankRow, out: &Path) {
         let _ = writeln!(s, "<p>Files: {}</p>", links.join(" · "));
     }
     s.push_str("</section>\n");
+}
+
+/// One case's pin contact for the design's table: the arcs, peak pressures, the big-end bore's
+/// ovality and the clearances.
+fn contact_line(
+    case: &crate::rod::LoadCaseResult,
+    k: &crate::rod::records::PinContactRecord,
+) -> String {
+    let b = match (k.arc_b_deg, k.peak_pressure_b_mpa) {
+        (Some(arc), Some(p)) => format!("bore B arc {arc:.0}°, peak {p:.1} MPa"),
+        _ => "bore B clamped (a force across the rod)".into(),
+    };
+    format!(
+        "{} case: bore A arc {:.0}° ({:.0}° to {:.0}° from the force), peak pressure {:.1} MPa; {b}; bore A's diameter changes {:+.2} µm along the force, {:+.2} µm across; radial clearances {:.1} / {:.1} µm",
+        crate::rod::cases::label(&case.name),
+        k.arc_a_deg,
+        k.arc_a_ends_deg[0],
+        k.arc_a_ends_deg[1],
+        k.peak_pressure_a_mpa,
+        k.ovality_a_along_um,
+        k.ovality_a_across_um,
+        k.clearance_a_um,
+        k.clearance_b_um
+    )
 }
 
 /// The integrators' work–precision plots and stage 3's speed–error plots, when present.

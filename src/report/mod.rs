@@ -4,6 +4,7 @@
 
 pub mod atomic_write;
 pub mod columns;
+pub mod contact_files;
 pub mod design_files;
 pub mod fields;
 pub mod index_page;

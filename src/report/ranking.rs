@@ -196,22 +196,28 @@ pub fn error_split(case: &crate::rod::LoadCaseResult) -> String {
         case.max_von_mises_away_from_fixed_mpa,
         100.0 * case.estimated_error_rel
     );
+    let mut parts = vec![format!("{:.1} % discretisation", 100.0 * d)];
     match case.estimated_geometry_error_rel {
-        None => format!("{head} (discretisation; geometry not estimated)"),
+        None => parts.push("geometry not estimated".into()),
         Some(g) if g == 0.0 && case.smooth_surface_peak_mpa.is_none() => {
-            format!("{head} (discretisation alone: the exact geometry)")
+            parts.push("no geometry part (the exact geometry)".into())
         }
-        Some(g) => format!(
-            "{head} = {:.1} % discretisation + {:.1} % geometry (the STL's facets): {} dominates",
-            100.0 * d,
-            100.0 * g,
-            if g > d {
-                "the geometry"
-            } else {
-                "the discretisation"
-            }
-        ),
+        Some(g) => parts.push(format!("{:.1} % geometry (the STL's facets)", 100.0 * g)),
     }
+    match (case.estimated_load_model_error_rel, &case.load_models) {
+        (Some(l), Some(m)) => parts.push(format!(
+            "{:.1} % load model (uniform {:.1} against contact {:.1} MPa)",
+            100.0 * l,
+            m.uniform_mpa,
+            m.contact_mpa
+        )),
+        _ => parts.push("load model not compared".into()),
+    }
+    format!(
+        "{head} = {}: the {} dominates",
+        parts.join(" + "),
+        case.dominant_error()
+    )
 }
 
 /// The error bars of all judged peaks of `fem` ([`error_split`]), from the last case to the first
@@ -250,7 +256,7 @@ pub fn error_notes(results: &StudyResults) -> Vec<(String, String)> {
 }
 
 /// The sentence above the error list.
-pub const ERROR_PREAMBLE: &str = "The estimated error of each judged peak is the sum of two parts (a bound: where both lower or both raise the peak they add): the discretisation (the mesh: the adaptive sequence's estimate) and, for an STL, the geometry (what the facets do: the same mesh curved onto a smooth surface through the STL's vertices and solved again). A STEP design is meshed on its exact geometry with curved elements: no geometry part.";
+pub const ERROR_PREAMBLE: &str = "The estimated error of each judged peak is the sum of three parts (a bound: where they move the peak the same way they add): the discretisation (the mesh: the adaptive sequence's estimate), for an STL the geometry (what the facets do: the same mesh curved onto a smooth surface through the STL's vertices and solved again; a STEP design is meshed on its exact geometry with curved elements: no geometry part), and the load model (how the pin force enters the rod: the thesis' uniform traction against frictionless contact with the pins at their clearances, both on the final mesh).";
 
 /// Per design, the warnings of its FEM record.
 pub fn fem_warnings(results: &StudyResults) -> Vec<(String, String)> {

@@ -84,6 +84,7 @@ pub fn compare_load_models(
                 cosine_mpa: c.max_von_mises_away_from_fixed_mpa,
                 contact_mpa: k.max_von_mises_away_from_fixed_mpa,
                 contact_at_mm: k.max_von_mises_away_from_fixed_at_mm,
+                contact_discretisation_error_rel: k.estimated_discretisation_error_rel,
                 contact: record,
             })
         })

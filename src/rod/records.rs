@@ -165,6 +165,9 @@ pub struct LoadModelPeaks {
     pub contact_mpa: f64,
     /// Where the contact peak is, mm.
     pub contact_at_mm: [f64; 3],
+    /// The contact peak's discretisation error on this mesh (the single-mesh recovery bound: the
+    /// mesh was refined for the model the case was solved under, not for contact's peak).
+    pub contact_discretisation_error_rel: f64,
     /// The pins' contact.
     pub contact: PinContactRecord,
 }

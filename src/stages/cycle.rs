@@ -11,12 +11,13 @@
 //! F_B of the dynamics at every instant; the stage reports how far those properties are from the
 //! STL's exact ones.
 
+use crate::rod::cycle::contact_instants::contact_at_instants_that_matter;
 use super::records::{CosineBoreLoadCases, DesignCycle, DesignMass, StageMesh};
 use crate::config::StudyConfig;
 use crate::fem::QuadratureChoice;
 use crate::fem::body_force::mesh_mass_properties;
 use crate::fem::material::Material;
-use crate::mechanism::rod_frame_engine_cycle;
+use crate::mechanism::{RodFrameInstant, rod_frame_engine_cycle};
 use crate::rod::cycle::{
     CycleOptions, CycleSolution, DEFAULT_DIRECTION_STEP_DEG, PinBasis, UnitSolutions, combine,
     rod_inertia_of, unit_solutions_for,
@@ -54,12 +55,9 @@ pub struct CycleOutcome {
     pub cycle: CycleSolution,
 }
 
-/// Runs the cycle stage on stage 3's mesh (writes nothing).
-pub fn cycle(mass: &DesignMass, mesh: &StageMesh, config: &StudyConfig) -> Result<CycleOutcome> {
-    let start = Instant::now();
-    let context = || format!("{}: cycle", mass.file);
-    let material = Material::from(&config.fem);
-    let options = CycleOptions {
+/// The cycle's settings for `mass` on stage 3's `mesh`.
+pub fn cycle_options(mass: &DesignMass, mesh: &StageMesh, config: &StudyConfig) -> CycleOptions {
+    CycleOptions {
         density_kg_m3: mass.density_kg_m3,
         fixed_band_m: mesh.fixed_band_m,
         singular_edges_m: mesh.singular_edges_m.clone(),
@@ -69,23 +67,55 @@ pub fn cycle(mass: &DesignMass, mesh: &StageMesh, config: &StudyConfig) -> Resul
         mean_stress: config.material.mean_stress,
         quadrature: QuadratureChoice::Auto,
         direction_step_deg: DEFAULT_DIRECTION_STEP_DEG,
-    };
-    // the loads from the mesh's own mass properties (those the body forces integrate to)
+    }
+}
+
+/// The instants of the cycle in the rod frame, from the mesh's own mass properties (those the
+/// body forces integrate to), over one revolution or, with a pressure trace, 720°.
+pub fn cycle_instants(
+    mass: &DesignMass,
+    mesh: &StageMesh,
+    config: &StudyConfig,
+) -> Result<Vec<RodFrameInstant>> {
+    let context = || format!("{}: cycle", mass.file);
     let mesh_mass = mesh_mass_properties(&mesh.mesh, mass.density_kg_m3);
     let params = super::dynamics::engine_mechanism_for(mass, &config.engine, true);
     let gas = config.engine.gas_force().with_context(context)?;
-    let instants = rod_frame_engine_cycle(
+    rod_frame_engine_cycle(
         &params,
         &rod_inertia_of(&mesh_mass),
         config.driven.omega_rad_s,
         config.cycle.instants,
         gas.as_deref(),
     )
-    .with_context(context)?;
+    .with_context(context)
+}
+
+/// Runs the cycle stage on stage 3's mesh (writes nothing).
+pub fn cycle(mass: &DesignMass, mesh: &StageMesh, config: &StudyConfig) -> Result<CycleOutcome> {
+    let start = Instant::now();
+    let context = || format!("{}: cycle", mass.file);
+    let material = Material::from(&config.fem);
+    let options = cycle_options(mass, mesh, config);
+    let gas = config.engine.gas_force().with_context(context)?;
+    let instants = cycle_instants(mass, mesh, config)?;
     let units = unit_solutions_for(&mesh.mesh, &material, &mesh.bores, &options, &instants)
         .with_context(context)?;
     let span_deg = if gas.is_some() { 720.0 } else { 360.0 };
     let cycle = combine(&units, &instants, &options).with_context(context)?;
+    let contact_instants = if config.fem.load_model_error {
+        contact_at_instants_that_matter(
+            &mesh.mesh,
+            &material,
+            &mesh.bores,
+            &options,
+            &instants,
+            &cycle,
+        )
+        .with_context(context)?
+    } else {
+        Vec::new()
+    };
     let analysis_seconds = start.elapsed().as_secs_f64();
     let nodes = mesh.mesh.nodes();
     let mm = |n: usize| nodes[n].map(|v| v * 1e3);
@@ -127,6 +157,7 @@ pub fn cycle(mass: &DesignMass, mesh: &StageMesh, config: &StudyConfig) -> Resul
             }),
         },
         mean_stress: config.material.mean_stress,
+        contact_instants,
         vtu: None,
         picture: None,
         analysis_seconds,

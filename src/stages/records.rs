@@ -227,6 +227,12 @@ pub struct DesignCycle {
     /// a uniform bore load, two pin cases).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cosine_bore_load: Option<CosineBoreLoadCases>,
+    /// The cycle with the pins in contact at the instants that matter (peak compression, tension,
+    /// transverse force, the linear cycle's worst), beside the linear cycle's judged peak there
+    /// ([`crate::rod::cycle::contact_instants`]); empty where not solved
+    /// (`[fem] load_model_error = false`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub contact_instants: Vec<crate::rod::cycle::contact_instants::ContactInstant>,
     /// The mean-stress correction of the fatigue factor (absent: Goodman).
     #[serde(default, skip_serializing_if = "MeanStress::is_goodman")]
     pub mean_stress: MeanStress,

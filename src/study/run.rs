@@ -287,6 +287,17 @@ fn study_one(
             )?;
             fields::write_fem_fields(&mut f.record.fem, &f.solution, &f.mesh.mesh, &dir, "fem")
                 .with_context(context)?;
+            let contact = match &f.contact {
+                Some((mesh, solution)) => Some((mesh, solution)),
+                None => {
+                    (!f.solution.contact_fields.is_empty()).then_some((&f.mesh.mesh, &f.solution))
+                }
+            };
+            if let Some((mesh, solution)) = contact {
+                crate::report::contact_files::write_contact_fields(solution, mesh, &dir)
+                    .with_context(context)?;
+            }
+            drop(f.contact);
             drop(f.solution);
             let mut record = f.record;
             if config.cycle.enabled {

@@ -1,0 +1,217 @@
+//! The cycle with the pins in contact at the instants that matter. Contact is not superposable
+//! (the arc depends on the load), so the linear cycle ([`super::combine`]) cannot carry it; instead
+//! the rod is solved directly with contact at a few instants: peak compression (largest F_A,x on
+//! the rod, towards B), peak tension (most negative F_A,x), peak force across the rod (largest
+//! |F_A,y|) and the linear cycle's worst instant, and its judged peak compared with the linear
+//! cycle's at the same instant.
+//!
+//! At an instant the rod carries the d'Alembert body force ρ (g − a_P) (the four body-force unit
+//! loads of [`super::unit_cases`] combined with the instant's coefficients), pin A a rigid cylinder
+//! of radius r_A − c_A with the crank's force F_A on it, and is held by pin B, a fixed rigid
+//! cylinder of radius r_B − c_B, in contact with bore B (where the linear cycle fixes all of bore
+//! B's DOFs). The loads are in balance by the dynamics on the mesh's own mass properties, so the
+//! support of the rotation about pin B that frictionless contact leaves free carries ~0; its
+//! moment is reported relative to |F_A| × the centre distance.
+
+use serde::{Deserialize, Serialize};
+
+use super::unit_cases::{CycleOptions, coefficients};
+use super::{CycleInstant, CycleSolution};
+use crate::fem::body_force::{BodyShape, body_force_load};
+use crate::fem::boundary::{boundary_faces, norm};
+use crate::fem::contact::{ContactProblem, ContactTolerances, PinMotion, solve_contact};
+use crate::fem::error::{FemError, Result};
+use crate::fem::material::Material;
+use crate::fem::mesh::TetMesh;
+use crate::fem::stress::{peak_nodal, stress_field};
+use crate::mechanism::RodFrameInstant;
+use crate::rod::bores::{BoreSpec, find_bores};
+use crate::rod::contact_cases::{clearances_m, pin_in};
+use crate::rod::judged::{Bands, judged_nodes};
+
+/// One instant solved with contact, beside the linear cycle's figure at the same instant.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ContactInstant {
+    /// Why this instant: "peak compression", "peak tension", "peak transverse", "worst linear"
+    /// (several, joined, where they coincide).
+    pub reason: String,
+    pub crank_angle_deg: f64,
+    /// The pin force on the rod at A, rod frame, N.
+    pub f_a_on_rod_n: [f64; 2],
+    /// The judged peak of the linear cycle (uniform or cosine bore load, bore B fixed), MPa.
+    pub linear_mpa: f64,
+    /// The judged peak with the pins in contact, MPa, and where (rod frame, mm).
+    pub contact_mpa: f64,
+    pub contact_at_mm: [f64; 3],
+    /// (contact − linear) / linear.
+    pub change_rel: f64,
+    /// The contact arcs on bores A and B, degrees, and their peak pressures, MPa.
+    pub arc_a_deg: f64,
+    pub arc_b_deg: f64,
+    pub peak_pressure_a_mpa: f64,
+    pub peak_pressure_b_mpa: f64,
+    /// |moment| of the support of the rotation about pin B / (|F_A| × centre distance).
+    pub restraint_moment_rel: f64,
+}
+
+/// The instants of `instants` that matter for contact, with the reasons: peak compression, peak
+/// tension (only where F_A,x < 0 somewhere), peak transverse force, and the linear cycle's worst
+/// instant `linear_worst`; each instant once, in crank-angle order.
+pub fn instants_that_matter(
+    instants: &[RodFrameInstant],
+    linear_worst: usize,
+) -> Vec<(usize, String)> {
+    let arg = |key: &dyn Fn(&RodFrameInstant) -> f64| {
+        (0..instants.len())
+            .max_by(|&a, &b| key(&instants[a]).total_cmp(&key(&instants[b])))
+            .unwrap_or(0)
+    };
+    let mut picked: Vec<(usize, &str)> = vec![
+        (arg(&|i| i.f_a_on_rod_n[0]), "peak compression"),
+        (arg(&|i| i.f_a_on_rod_n[1].abs()), "peak transverse"),
+        (linear_worst, "worst linear"),
+    ];
+    let tension = arg(&|i| -i.f_a_on_rod_n[0]);
+    if instants
+        .get(tension)
+        .is_some_and(|i| i.f_a_on_rod_n[0] < 0.0)
+    {
+        picked.push((tension, "peak tension"));
+    }
+    let mut out: Vec<(usize, String)> = Vec::new();
+    for (k, why) in picked {
+        match out.iter_mut().find(|(j, _)| *j == k) {
+            Some((_, reasons)) => {
+                reasons.push_str(", ");
+                reasons.push_str(why);
+            }
+            None => out.push((k, why.to_string())),
+        }
+    }
+    out.sort_by(|a, b| {
+        instants[a.0]
+            .crank_angle_deg
+            .total_cmp(&instants[b.0].crank_angle_deg)
+    });
+    out
+}
+
+/// Solves the rod `mesh` with contact at each instant of `which` (indices into `instants`, with
+/// reasons), against the linear cycle's `history`.
+pub fn contact_instants(
+    mesh: &TetMesh,
+    material: &Material,
+    bores: &BoreSpec,
+    options: &CycleOptions,
+    instants: &[RodFrameInstant],
+    history: &[CycleInstant],
+    which: &[(usize, String)],
+) -> Result<Vec<ContactInstant>> {
+    let boundary = boundary_faces(mesh)?;
+    let (loaded, fixed) = find_bores(mesh, &boundary, bores)?;
+    let axis = bores.unit_axis()?;
+    let [c_a, c_b] = clearances_m(bores, &loaded, &fixed);
+    let body: Vec<Vec<f64>> = [
+        BodyShape::UniformX,
+        BodyShape::UniformY,
+        BodyShape::Centrifugal,
+        BodyShape::AngularAccel,
+    ]
+    .into_iter()
+    .map(|shape| body_force_load(mesh, options.density_kg_m3, shape))
+    .collect();
+    let bands = Bands {
+        fixed_faces: &fixed.faces,
+        fixed_band_m: options.fixed_band_m,
+        singular_edges_m: &options.singular_edges_m,
+        singular_band_m: options.singular_band_m,
+    };
+    let judged = judged_nodes(mesh, &bands).judged;
+    let centre_distance = norm(std::array::from_fn(|j| {
+        fixed.centre_m[j] - loaded.centre_m[j]
+    }));
+    which
+        .iter()
+        .map(|(k, reason)| {
+            let inst = instants.get(*k).ok_or_else(|| {
+                FemError::InvalidInput(format!("contact instant {k} is not in the cycle"))
+            })?;
+            let c = coefficients(inst);
+            let mut loads = vec![0.0; mesh.n_dofs()];
+            for (b, coeff) in body.iter().zip(&c[2..]) {
+                for (l, v) in loads.iter_mut().zip(b) {
+                    *l += coeff * v;
+                }
+            }
+            let f_a = [inst.f_a_on_rod_n[0], inst.f_a_on_rod_n[1], 0.0];
+            let problem = ContactProblem {
+                mesh,
+                material: *material,
+                quadrature: options.quadrature,
+                prescribed: Vec::new(),
+                loads,
+                cylinders: vec![
+                    pin_in(&loaded, axis, c_a, PinMotion::Force(f_a))?,
+                    pin_in(&fixed, axis, c_b, PinMotion::Fixed)?,
+                ],
+                tolerances: ContactTolerances {
+                    free_mode_reaction_rel: None,
+                    ..ContactTolerances::default()
+                },
+            };
+            let s = solve_contact(&problem).map_err(|e| {
+                FemError::Problem(format!(
+                    "the cycle with contact at φ = {:.0}° ({reason}): {e}",
+                    inst.crank_angle_deg
+                ))
+            })?;
+            let stress = stress_field(mesh, material, &s.displacements)?;
+            let peak = peak_nodal(mesh, &stress.von_mises_averaged(), Some(&judged));
+            let linear = history
+                .get(*k)
+                .ok_or_else(|| {
+                    FemError::InvalidInput(format!("contact instant {k} has no linear figure"))
+                })?
+                .max_von_mises_away_from_fixed_mpa;
+            let m = s.restraint.moment_nm;
+            let contact_mpa = peak.value * 1e-6;
+            Ok(ContactInstant {
+                reason: reason.clone(),
+                crank_angle_deg: inst.crank_angle_deg,
+                f_a_on_rod_n: inst.f_a_on_rod_n,
+                linear_mpa: linear,
+                contact_mpa,
+                contact_at_mm: peak.location_m.map(|v| v * 1e3),
+                change_rel: (contact_mpa - linear) / linear,
+                arc_a_deg: s.cylinders[0].arc_deg,
+                arc_b_deg: s.cylinders[1].arc_deg,
+                peak_pressure_a_mpa: s.cylinders[0].peak_pressure_pa * 1e-6,
+                peak_pressure_b_mpa: s.cylinders[1].peak_pressure_pa * 1e-6,
+                restraint_moment_rel: norm(m)
+                    / (norm(f_a) * centre_distance).max(f64::MIN_POSITIVE),
+            })
+        })
+        .collect()
+}
+
+/// [`contact_instants`] at the instants that matter ([`instants_that_matter`]) of the linear
+/// cycle `cycle`.
+pub fn contact_at_instants_that_matter(
+    mesh: &TetMesh,
+    material: &Material,
+    bores: &BoreSpec,
+    options: &CycleOptions,
+    instants: &[RodFrameInstant],
+    cycle: &CycleSolution,
+) -> Result<Vec<ContactInstant>> {
+    let which = instants_that_matter(instants, cycle.max_instant);
+    contact_instants(
+        mesh,
+        material,
+        bores,
+        options,
+        instants,
+        &cycle.history,
+        &which,
+    )
+}
