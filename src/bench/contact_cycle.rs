@@ -10,9 +10,7 @@ use anyhow::{Context, Result};
 use serde::Serialize;
 
 use crate::config::StudyConfig;
-use crate::rod::cycle::contact_instants::{
-    ContactInstant, contact_instants, instants_that_matter,
-};
+use crate::rod::cycle::contact_instants::{ContactInstant, contact_instants, instants_that_matter};
 use crate::stages::fem::{FemLoads, MeshMode};
 
 /// The comparison of one design.
@@ -48,7 +46,10 @@ pub fn bench_contact_cycle(
     let design = crate::stages::mass::load(design_file)?;
     let mass = crate::stages::mass::mass(&design)?;
     let loads = FemLoads::of_design(&design, config)?;
-    let work = std::env::temp_dir().join(format!("rodstudy-bench-contact-cycle-{}", std::process::id()));
+    let work = std::env::temp_dir().join(format!(
+        "rodstudy-bench-contact-cycle-{}",
+        std::process::id()
+    ));
     let f = crate::stages::fem::fem(&design, &loads, config, &work, mode)?;
     let _ = std::fs::remove_dir_all(&work);
     let t = Instant::now();

@@ -202,7 +202,9 @@ pub fn run(command: BenchCommand) -> Result<i32> {
                 Some(h) => crate::stages::fem::MeshMode::Fixed(h),
                 None => crate::stages::fem::MeshMode::from_config(&config),
             };
-            let b = crate::bench::contact_cycle::bench_contact_cycle(&design, &config, &mode, instants)?;
+            let b = crate::bench::contact_cycle::bench_contact_cycle(
+                &design, &config, &mode, instants,
+            )?;
             if json {
                 outln!("{}", serde_json::to_string_pretty(&b)?);
             } else {

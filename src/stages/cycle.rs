@@ -11,13 +11,13 @@
 //! F_B of the dynamics at every instant; the stage reports how far those properties are from the
 //! STL's exact ones.
 
-use crate::rod::cycle::contact_instants::contact_at_instants_that_matter;
 use super::records::{CosineBoreLoadCases, DesignCycle, DesignMass, StageMesh};
 use crate::config::StudyConfig;
 use crate::fem::QuadratureChoice;
 use crate::fem::body_force::mesh_mass_properties;
 use crate::fem::material::Material;
 use crate::mechanism::{RodFrameInstant, rod_frame_engine_cycle};
+use crate::rod::cycle::contact_instants::contact_at_instants_that_matter;
 use crate::rod::cycle::{
     CycleOptions, CycleSolution, DEFAULT_DIRECTION_STEP_DEG, PinBasis, UnitSolutions, combine,
     rod_inertia_of, unit_solutions_for,
