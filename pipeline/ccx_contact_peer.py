@@ -420,6 +420,7 @@ def main(argv=None) -> int:
     stats = read_contact_statistics(work / "rod.dat")
     ip = read_integration_point_pressures(work / "rod.dat")
     figures["pin_a_reaction_n"] = reactions.get("NPIN0")
+    figures["pin_a_displacement_mm"] = blocks["DISP"][n + 1][:3]
     figures["pin_b_reaction_n"] = reactions.get("NPIN1")
     wall_faces = [{(int(e) + 1, int(f)): True for e, f in zip(*w)} for w in walls]
     for k, (name, centre, i) in enumerate(zip("ab", centres, info)):
