@@ -2,8 +2,8 @@
 """Independent peer of rodstudy's pin-bore contact: the same rod, pins and mesh solved by CalculiX.
 
   ccx_contact_peer.py MESH.rodmesh [--force 20000] [--clearance-a 0.01] [--clearance-b 0.01]
-                      [--slope K] [--pin-facets 4] [--clearance-card] [--band 3] [--judged FILE]
-                      [--json] [--workdir DIR] [--ccx ccx]
+                      [--slope K] [--pin-facets N] [--pin-layers 4] [--band 3] [--judged FILE]
+                      [--json] [--workdir DIR [--reuse]] [--ccx ccx]
 
 Reads the mesh rodstudy solved (the .rodmesh hand-off file, VTK tetra10 order = CalculiX's C3D10
 order) and builds the contact model independently, with numpy (units mm, N, MPa):
@@ -11,14 +11,12 @@ order) and builds the contact model independently, with numpy (units mm, N, MPa)
     --bore-b), axis z, by the rule of ccx_peer.py (boundary faces whose normal points at the axis
     within 30 degrees, all corners on the innermost radius within 1 %): the slave surfaces,
     element faces of the C3D10;
-  * each pin a tube of 8-node bricks whose outer faces are the master surface: radius r - c (r the
-    bore radius found, c the radial clearance; c < 0 an interference), PIN_FACETS facets per node
-    pitch of the wall around, bricks about square, reaching 1 mm past the wall at both ends. With
-    --clearance-card the tube has the bore's radius and c enters as *CLEARANCE (ccx then moves the
-    slave nodes so that every gap starts at c, as rodstudy measures its gap from the nominal
-    radius). The pins are rigid: pin B's nodes fixed; pin A's nodes translate along x as one
-    (*EQUATION on every node's x to its first node, which carries the force F along +x as *CLOAD),
-    y and z fixed;
+  * each pin a tube of 20-node bricks (C3D20, every node on its circle) whose outer faces are the
+    master surface: radius r - c (r the bore radius found, c the radial clearance; c < 0 an
+    interference), one brick per node pitch of the wall around (--pin-facets), 4 along the axis
+    (--pin-layers), reaching 1 mm past the wall at both ends. The pins are rigid: pin B's nodes
+    fixed; pin A's nodes translate along x as one (*EQUATION on every node's x to its first node,
+    which carries the force F along +x as *CLOAD), y and z fixed;
   * frictionless face-to-face penalty contact (*CONTACT PAIR, TYPE=SURFACE TO SURFACE, no
     *FRICTION), PRESSURE-OVERCLOSURE=LINEAR with slope K (N/mm^3, default 100 E / h, h the mean
     edge of the walls) and no tension;
@@ -28,21 +26,24 @@ order) and builds the contact model independently, with numpy (units mm, N, MPa)
     body; pin A's reaction along y is printed and must be ~0);
   * steel E = 210 GPa, nu = 0.3.
 ccx (SPOOLES, OMP_NUM_THREADS=2 unless set) solves one *STATIC step; contact makes it nonlinear
-and ccx iterates (*CONTROLS tightens the residual criteria). Read back: nodal stresses from the
+and ccx iterates to its default criteria. Read back: nodal stresses from the
 .frd (integration-point values extrapolated to the nodes and averaged; von Mises of the averaged
 tensor), the nodal contact pressure CPRESS (.frd), the pressure at every active slave
 integration point and each pair's contact area, normal and shear force (.dat, *CONTACT PRINT
 CSTR and CF). Printed: the peak von Mises away from both bores (nodes farther than BAND mm from
-both walls; with --judged FILE, a 0/1 per node, also over those nodes), per bore the peak nodal
-and integration-point contact pressure, the contact arc (360 degrees - the largest angular gap
-between wall nodes with CPRESS > 0), the contact area and forces, an element's angular size, and
-the pins' reactions.
+both walls; with --judged FILE, a 0/1 per node, also over those nodes), per bore the peak nodal,
+smoothed (as rodstudy smooths its own) and integration-point contact pressure, the resultant of
+the nodal pressure, the contact arc (360 degrees - the largest angular gap
+between wall nodes with CPRESS > 0), the contact area and forces, an element's angular size, the pins'
+reactions and pin A's travel.
 
-Measured on 2026-11-29 (docs/contact.md, "Against CalculiX"): ccx 2.20's face-to-face penalty
-contact on these C3D10 walls carries the pin force on a fraction of the area rodstudy's contact
-(and the Fourier-series reference of tests/contact.rs) gives, with a shear force of ~8 % of the
-normal force although no friction is defined, and its nodal CPRESS does not integrate to the pin
-force; the far-field von Mises agrees, the contact pressure and arc do not.
+ccx measures the gap between the quadratic wall faces and the pin: the walls must be curved
+(midside nodes on the circle) and fine enough that a face is within a few nm of the circle
+(3.75 degree elements on a 25 mm bore), else the contact gathers on the faces' high points.
+Node-to-surface contact and *CLEARANCE were tried and are not usable here (docs/contact.md,
+"Against CalculiX", measured 2026-11-29).
+
+With --reuse the results already in --workdir are read instead of running ccx.
 
 Exit status 0; 2 if ccx is missing; 1 if ccx fails.
 """
@@ -115,9 +116,9 @@ BRICK20 = [(-1, -1, -1), (1, -1, -1), (1, 1, -1), (-1, 1, -1), (-1, -1, 1), (1, 
 def pin_mesh(centre, rho, z0, z1, n_theta, nz, first_node):
     """The rigid pin of a bore: a tube of 20-node bricks (C3D20) of outer radius rho, inner 0.8 rho,
     n_theta around, nz along the axis from z0 to z1, every node on its circle, so that the outer
-    faces (face S4 of each brick, the master surface) are quadratic arcs: within
-    rho (pi / n_theta)^4 / 8 or so of the cylinder (0.9 nm at rho = 25 mm, n_theta = 96), where
-    flat facets would be off by their sagitta rho (1 - cos(pi / n_theta)) (13 um).
+    faces (face S4 of each brick, the master surface) are quadratic arcs: 0.9 nm off the cylinder
+    at rho = 25 mm and 3.75 degree bricks (computed), where flat facets of that size would be off
+    by their sagitta, 13 um.
     Returns (nodes (n, 3), bricks (m, 20) global 0-based ids)."""
     ids, nodes, bricks = {}, [], []
 
@@ -142,7 +143,7 @@ def lines_of(ids, per=12):
     return [", ".join(s[i:i + per]) for i in range(0, len(s), per)]
 
 
-def write_deck(path, pts, tets, walls, pins, force, behaviour, rod_z_node, use_clearance, contact_type):
+def write_deck(path, pts, tets, walls, pins, force, slope, rod_z_node):
     """walls: [(elements, sides)] per bore; pins: [(nodes, bricks, clearance)] (A first)."""
     n_rod = len(pts)
     out = ["*HEADING", "rodstudy CalculiX contact peer (mm, N, MPa)", "*NODE"]
@@ -178,12 +179,10 @@ def write_deck(path, pts, tets, walls, pins, force, behaviour, rod_z_node, use_c
     for k in range(len(pins)):
         out.append(f"*SOLID SECTION, ELSET=PIN{k}, MATERIAL=STEEL")
     out += ["*SURFACE INTERACTION, NAME=FRICTIONLESS",
-            "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR", behaviour]
+            "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR", f"{slope:.13g}, 0.0"]
     for k, (_, _, clearance) in enumerate(pins):
-        out += [f"*CONTACT PAIR, INTERACTION=FRICTIONLESS, TYPE={contact_type}",
+        out += ["*CONTACT PAIR, INTERACTION=FRICTIONLESS, TYPE=SURFACE TO SURFACE",
                 f"WALL{k}, PIN{k}"]
-        if use_clearance:
-            out.append(f"*CLEARANCE, MASTER=PIN{k}, SLAVE=WALL{k}, VALUE={clearance:.13g}")
     # pin A: every node's x equal to its first node's
     out.append("*EQUATION")
     for n in range(starts[0] + 1, starts[1]):
@@ -300,7 +299,7 @@ def arc(angles_deg: np.ndarray):
     gaps = np.diff(np.concatenate([a, [a[0] + 360.0]]))
     i = int(np.argmax(gaps))
     lo, hi = a[(i + 1) % len(a)], a[i]
-    ends = ((lo + 180.0) % 360.0 - 180.0, (hi + 180.0) % 360.0 - 180.0)
+    ends = (float((lo + 180.0) % 360.0 - 180.0), float((hi + 180.0) % 360.0 - 180.0))
     return 360.0 - gaps[i], ends
 
 
@@ -311,15 +310,9 @@ def main(argv=None) -> int:
     ap.add_argument("--clearance-a", type=float, default=0.01, help="radial clearance of pin A, mm (default 0.01)")
     ap.add_argument("--clearance-b", type=float, default=0.01, help="radial clearance of pin B, mm (default 0.01)")
     ap.add_argument("--slope", type=float, help="penalty slope K, N/mm^3 (default 100 E / h)")
-    ap.add_argument("--clearance-card", action="store_true",
-                    help="the pin of the bore's radius and the clearance as *CLEARANCE")
     ap.add_argument("--pin-facets", type=int,
                     help="the pin's facets around (default: one per node pitch of the wall)")
     ap.add_argument("--pin-layers", type=int, default=4, help="the pin's bricks along its axis (default 4)")
-    ap.add_argument("--tension", type=float, default=1e-3,
-                    help="node-to-surface: the tension at large clearances, MPa (default 1e-3)")
-    ap.add_argument("--node-to-surface", action="store_true",
-                    help="node-to-surface contact (the wall's nodes against the pin's faces)")
     ap.add_argument("--band", type=float, default=3.0,
                     help="nodes within this distance of a bore wall (mm) are left out of the peak von Mises")
     ap.add_argument("--judged", help="a 0/1 per node: the nodes of a second peak von Mises")
@@ -354,14 +347,12 @@ def main(argv=None) -> int:
         element_deg = float(np.degrees(np.ptp(np.unwrap(tc, axis=1), axis=1).mean()))
         # facets per node pitch (half an element) around
         n_theta = args.pin_facets if args.pin_facets else int(round(2 * 360.0 / element_deg))
-        rho = r if args.clearance_card else r - clearance
-        pn, pb = pin_mesh(centre, rho, z.min() - 1.0, z.max() + 1.0, n_theta, args.pin_layers, node0)
+        pn, pb = pin_mesh(centre, r - clearance, z.min() - 1.0, z.max() + 1.0, n_theta, args.pin_layers, node0)
         node0 += len(pn)
         walls.append((felem[sel], fside[sel]))
         pins.append((pn, pb, clearance))
         info.append({"radius_mm": float(r), "faces": int(sel.sum()), "nodes": nodes, "theta": th, "wall": wf,
                      "edge_mm": float(h), "element_deg": element_deg, "pin_facets": n_theta})
-    # pin brick ids are local: shift to global node numbers was done through node0
     h_wall = np.mean([i["edge_mm"] for i in info])
     slope = args.slope if args.slope else 100.0 * E_MPA / h_wall
     centre_rod = 0.5 * (centres[0] + centres[1])
@@ -369,20 +360,15 @@ def main(argv=None) -> int:
     rod_z_node = int(np.argmin(np.linalg.norm(pts - centre_rod, axis=1)))
     work = pathlib.Path(args.workdir) if args.workdir else pathlib.Path(tempfile.mkdtemp(prefix="ccx_contact_"))
     work.mkdir(parents=True, exist_ok=True)
-    behaviour = f"{slope:.13g}, 0.0"
-    if args.node_to_surface:
-        # node-to-face springs exist up to the clearance c0, with a small tension sigma_inf beyond
-        c0 = 5.0 * max(abs(args.clearance_a), abs(args.clearance_b), 1e-3)
-        behaviour = f"{slope:.13g}, {args.tension:.13g}, {c0:.13g}"
-    if not args.reuse:
-        write_deck(work / "rod.inp", pts, tets, walls, pins, args.force, behaviour, rod_z_node, args.clearance_card,
-                   "NODE TO SURFACE" if args.node_to_surface else "SURFACE TO SURFACE")
+    frd = work / "rod.frd"
+    reuse = args.reuse and frd.exists()
+    if not reuse:
+        write_deck(work / "rod.inp", pts, tets, walls, pins, args.force, slope, rod_z_node)
     env = dict(os.environ)
     env.setdefault("OMP_NUM_THREADS", "2")
     env.setdefault("CCX_NPROC_EQUATION_SOLVER", env["OMP_NUM_THREADS"])
-    frd = work / "rod.frd"
     t0 = time.perf_counter()
-    if not (args.reuse and frd.exists()):
+    if not reuse:
         run = run_ccx(ccx, work, env)
         if run is None:
             return 1
