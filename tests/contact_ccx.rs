@@ -13,9 +13,9 @@
 //!
 //! Checked: the peak von Mises more than 3 mm from both bore walls within 2 %; bore A's peak
 //! smoothed contact pressure (`smoothed_pressure_pa`; for ccx the same smoothing of its nodal
-//! CPRESS) within 2 %; the ends of bore A's contact arc each within one element of ccx's (ccx
-//! extrapolates the pressure of a face's integration points to all its nodes, so the nodes of the
-//! face where contact ends read > 0: its arc is one element longer at each end, measured); ccx's
+//! CPRESS) within 2 %; the ends of bore A's contact arc each within one element of ccx's (ccx's
+//! arc is one element longer at each end, at K and at 10 K; likely because ccx extrapolates a
+//! face's integration-point pressures to all its nodes; docs/contact.md); ccx's
 //! nodal pressure integrating to the pin force within 2 %; pin A's travel within 1 %; the same
 //! wall on both sides.
 //!
