@@ -16,7 +16,7 @@ use rodstudy::fem::mesh::mirror::mirror;
 use rodstudy::fem::mesh::structured::{TwoEyePlate, two_eye_plate};
 use rodstudy::mechanism::RodFrameInstant;
 use rodstudy::rod::contact_load::{PinContact, solve_rod_contact};
-use rodstudy::rod::cycle::contact_instants::contact_instants;
+use rodstudy::rod::cycle::contact_instants::{contact_instants, instants_that_matter};
 use rodstudy::rod::cycle::{CycleInstant, CycleOptions, DEFAULT_DIRECTION_STEP_DEG};
 use rodstudy::rod::fatigue::MeanStress;
 use rodstudy::rod::half_model::solve_rod_on;
@@ -190,4 +190,39 @@ fn a_cycle_instant_without_inertia_is_the_static_contact_case() {
     assert!(rel < 1e-9, "{rel:e}: {:?}", r[0]);
     assert!((r[0].arc_a_deg - direct.bore_a.arc_deg).abs() < 1e-9);
     assert!(r[0].restraint_moment_rel < 1e-8, "{:?}", r[0]);
+}
+
+#[test]
+fn the_instants_that_matter_are_the_peaks_with_neighbours_merged() {
+    // F_A = (F cos φ, 0.3 F sin 2φ): tension at 0°, compression at 180°, transverse at 45°, …
+    let f = 5e3;
+    let instants: Vec<RodFrameInstant> = (0..360)
+        .map(|k| {
+            let phi = (k as f64).to_radians();
+            RodFrameInstant {
+                crank_angle_deg: k as f64,
+                time_s: 0.0,
+                a_a_m_s2: [0.0; 2],
+                omega3_rad_s: 0.0,
+                alpha3_rad_s2: 0.0,
+                gravity_m_s2: [0.0; 2],
+                f_a_on_rod_n: [-f * phi.cos(), 0.3 * f * (2.0 * phi).sin()],
+                f_b_on_rod_n: [0.0; 2],
+                gas_force_n: 0.0,
+            }
+        })
+        .collect();
+    // the linear worst 1° from the peak tension (a neighbour: merged), then 359° (across the end)
+    for (worst, expect_first) in [(1, 1usize), (359, 359)] {
+        let which = instants_that_matter(&instants, worst);
+        let angles: Vec<f64> = which
+            .iter()
+            .map(|(k, _)| instants[*k].crank_angle_deg)
+            .collect();
+        assert_eq!(which.len(), 3, "{which:?}");
+        assert!(angles.contains(&(expect_first as f64)) && angles.contains(&180.0));
+        let tension = which.iter().find(|(k, _)| *k == expect_first).unwrap();
+        assert!(tension.1.contains("worst linear") && tension.1.contains("peak tension"));
+        assert!(which.iter().any(|(_, r)| r == "peak transverse"));
+    }
 }

@@ -54,9 +54,15 @@ pub struct ContactInstant {
     pub restraint_moment_rel: f64,
 }
 
-/// The instants of `instants` that matter for contact, with the reasons: peak compression, peak
-/// tension (only where F_A,x < 0 somewhere), peak transverse force, and the linear cycle's worst
-/// instant `linear_worst`; each instant once, in crank-angle order.
+/// Instants of the cycle closer than this (degrees of crank angle, across the cycle's end too) are
+/// one for the choice of [`instants_that_matter`]: the linear worst 1° after the peak tension at
+/// top dead centre is the same load.
+pub const SAME_INSTANT_DEG: f64 = 3.0;
+
+/// The instants of `instants` that matter for contact, with the reasons: the linear cycle's worst
+/// instant `linear_worst`, peak compression, peak force across the rod and peak tension (only
+/// where F_A,x < 0 somewhere); an instant within [`SAME_INSTANT_DEG`] of one chosen before is that
+/// one (its reasons joined); in crank-angle order.
 pub fn instants_that_matter(
     instants: &[RodFrameInstant],
     linear_worst: usize,
@@ -67,9 +73,9 @@ pub fn instants_that_matter(
             .unwrap_or(0)
     };
     let mut picked: Vec<(usize, &str)> = vec![
+        (linear_worst, "worst linear"),
         (arg(&|i| i.f_a_on_rod_n[0]), "peak compression"),
         (arg(&|i| i.f_a_on_rod_n[1].abs()), "peak transverse"),
-        (linear_worst, "worst linear"),
     ];
     let tension = arg(&|i| -i.f_a_on_rod_n[0]);
     if instants
@@ -79,8 +85,19 @@ pub fn instants_that_matter(
         picked.push((tension, "peak tension"));
     }
     let mut out: Vec<(usize, String)> = Vec::new();
+    let angle = |k: usize| instants.get(k).map_or(f64::NAN, |i| i.crank_angle_deg);
+    let span = if instants.iter().any(|i| i.crank_angle_deg >= 360.0) {
+        720.0
+    } else {
+        360.0
+    };
     for (k, why) in picked {
-        match out.iter_mut().find(|(j, _)| *j == k) {
+        // an instant within SAME_INSTANT_DEG of one already chosen is that one
+        let near = |j: usize| {
+            let d = (angle(j) - angle(k)).abs().rem_euclid(span);
+            d.min(span - d) <= SAME_INSTANT_DEG
+        };
+        match out.iter_mut().find(|(j, _)| near(*j)) {
             Some((_, reasons)) => {
                 reasons.push_str(", ");
                 reasons.push_str(why);
