@@ -53,7 +53,7 @@ pub fn bench_contact_cycle(
     let f = crate::stages::fem::fem(&design, &loads, config, &work, mode)?;
     let _ = std::fs::remove_dir_all(&work);
     let t = Instant::now();
-    let mut no_contact = config.clone();
+    let mut no_contact = *config;
     no_contact.fem.load_model_error = false;
     let c = crate::stages::cycle::cycle(&mass, &f.mesh, &no_contact)?;
     let linear_s = t.elapsed().as_secs_f64();

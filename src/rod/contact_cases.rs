@@ -21,10 +21,11 @@
 
 use std::time::Instant;
 
+use crate::fem::element::QuadratureChoice;
+
 use super::bores::{BoreSpec, BoreSurface, default_clearance_m};
 use super::cases::{CaseDirection, STATIC_CASES};
 use super::records::PinContactRecord;
-use super::solve::{RodOptions, RodStatic};
 use crate::fem::contact::{
     ContactProblem, ContactSolution, ContactTolerances, Cylinder, PinMotion, diameter_change,
     solve_contact,
@@ -150,7 +151,7 @@ pub(super) fn contact_solutions(
     mesh: &TetMesh,
     material: &Material,
     bores: &BoreSpec,
-    options: &RodOptions,
+    quadrature: QuadratureChoice,
     cases: &[([f64; 3], f64)],
     (loaded, fixed, axis): (&BoreSurface, &BoreSurface, [f64; 3]),
     load_share: f64,
@@ -187,7 +188,7 @@ pub(super) fn contact_solutions(
         let problem = ContactProblem {
             mesh,
             material: *material,
-            quadrature: options.quadrature,
+            quadrature,
             prescribed,
             loads: Vec::new(),
             cylinders,
@@ -255,42 +256,4 @@ pub(super) fn contact_solutions(
         loads,
         solves,
     ))
-}
-
-/// [`contact_solutions`] as the cases' [`RodStatic`] (the contact solves in [`RodStatic::contact`]).
-#[allow(clippy::too_many_arguments)]
-pub(super) fn contact_static<'a>(
-    mesh: &'a TetMesh,
-    material: &Material,
-    bores: &BoreSpec,
-    options: &RodOptions,
-    cases: Vec<([f64; 3], f64)>,
-    (loaded, fixed, axis): (BoreSurface, BoreSurface, [f64; 3]),
-    load_share: f64,
-    held: &[usize],
-    t_all: Instant,
-) -> Result<RodStatic<'a>> {
-    let (sol, loads, solves) = contact_solutions(
-        mesh,
-        material,
-        bores,
-        options,
-        &cases,
-        (&loaded, &fixed, axis),
-        load_share,
-        held,
-    )?;
-    Ok(RodStatic {
-        mesh,
-        material: *material,
-        bores: bores.clone(),
-        t_all,
-        loaded,
-        fixed,
-        cases,
-        loads,
-        sol,
-        system: None,
-        contact: solves,
-    })
 }

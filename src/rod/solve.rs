@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 
 use super::bores::{BoreSpec, BoreSurface, find_bores};
 use super::cases::STATIC_CASES;
-use super::contact_cases::{ContactCase, contact_static};
+use super::contact_cases::{ContactCase, contact_solutions};
 use super::judged::{
     Bands, DEFAULT_FIXED_BAND_M, DEFAULT_SINGULAR_BAND_M, edge_band_warning, judged_nodes,
     singularity_floor,
@@ -211,17 +211,29 @@ pub(super) fn static_cases<'a>(
         .collect::<Result<Vec<_>>>()?;
     check_one_piece(mesh, &fixed.nodes)?;
     if bores.bore_load == BoreLoad::Contact {
-        return contact_static(
+        let (sol, loads, contact) = contact_solutions(
             mesh,
             material,
             bores,
-            options,
-            cases,
-            (loaded, fixed, axis),
+            options.quadrature,
+            &cases,
+            (&loaded, &fixed, axis),
             load_share,
             held,
+        )?;
+        return Ok(RodStatic {
+            mesh,
+            material: *material,
+            bores: bores.clone(),
             t_all,
-        );
+            loaded,
+            fixed,
+            cases,
+            loads,
+            sol,
+            system: None,
+            contact,
+        });
     }
     let loads = cases
         .iter()
