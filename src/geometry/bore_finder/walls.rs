@@ -550,7 +550,7 @@ mod tests {
             x
         };
         let angles: Vec<(u64, usize)> = (0..5000)
-            .map(|i| ((next() % 1000) as f64 * 6.283 / 1000.0, i))
+            .map(|i| ((next() % 1000) as f64 * std::f64::consts::TAU / 1000.0, i))
             .map(|(a, i)| (a.to_bits(), i))
             .collect();
         let small: Vec<(u64, usize)> = (0..5000).map(|i| (next() % 7, i)).collect();
