@@ -1,26 +1,32 @@
 #!/usr/bin/env python3
 """Volume meshing of a rod STL with quadratic tetrahedra for rodstudy's FEM stage (SPEC Stage 3).
 
-Two commands, both ending with one line of JSON on standard output (progress goes to standard error):
+A gmsh adapter: every meshing decision (the classification ladder, the fallbacks and their order,
+the local refinement's rounds and floor, quality limits, every gmsh option, the time limit) comes
+from rodstudy in `--policy JSON` (`src/mesher/policy.rs`, where each is written and explained); the
+script executes it and defines none. `rodstudy pipeline mesh_rod.py ...` adds the policy to a call
+by hand. Each command ends with one line of JSON on standard output (progress goes to standard
+error):
 
-  mesh_rod.py mesh STL OUT_DIR [--size 5] [--curved] [--name NAME] [--size-field FILE] [--geometry FILE]
-                               [--no-rodmesh]
+  mesh_rod.py mesh STL OUT_DIR --size MM --policy JSON [--curved] [--name NAME] [--size-field FILE]
+                               [--geometry FILE] [--no-rodmesh]
       STL as a CAD export comes (millimetres, triangle soup) -> gmsh: merge, classify the surface
       triangles into patches (`classifySurfaces`, angles in radians), `createGeometry` (reparametrised
       discrete surfaces), surface loop, volume, 3D mesh at the target size, second order (10-node
-      tetrahedra), optimisation. Deterministic: fixed options, one thread, fixed 3D algorithm and
-      random seed, so the same STL and size give the same mesh bit for bit.
+      tetrahedra), optimisation. Deterministic: the policy's options (one thread, fixed 3D algorithm
+      and random seed), so the same STL and size give the same mesh bit for bit.
       Meshing a surface reconstructed from an STL is fragile where tiny faces meet large ones (gmsh
-      may stop with "overlapping facets" or even crash), so the mesh is made in a child process and a
-      fixed ladder of classification settings is tried in order (`LADDER`: dihedral angle, curve
-      split angle) until one succeeds; the JSON says which rung was used and why earlier ones failed.
-      Where every rung fails, the surface is meshed differently (`FALLBACKS`, in this order): "local
-      refinement" (the sizes reduced around the patches gmsh blames, round after round) and "STL
-      surface kept" (the STL's own triangles as the boundary, only the interior meshed), both on the
-      bonded body where the STL holds shells touching face to face (`bond_shells`); the JSON's
-      `fallback` names the one that made the mesh (null for the usual mesh). A total failure ends
-      in one line that lists everything tried and what to try. Children stop a little before the
-      Rust side's time limit (RODSTUDY_MESHER_TIMEOUT_S, default 600 s), so that line is written.
+      may stop with "overlapping facets" or even crash), so the mesh is made in a child process and
+      the policy's ladder of classification settings (dihedral angle, curve split angle) is tried
+      in order until one succeeds; the JSON says which rung was used and why earlier ones failed.
+      Where every rung fails, the surface is meshed differently (the policy's fallbacks, in its
+      order): "local refinement" (the sizes reduced around the patches gmsh blames, round after
+      round) and "STL surface kept" (the STL's own triangles as the boundary, only the interior
+      meshed), both on the bonded body where the STL holds shells touching face to face
+      (`bond_shells`); the JSON's `fallback` names the one that made the mesh (null for the usual
+      mesh). A total failure ends in one line that lists everything tried and what to try. Children
+      stop at the policy's `time_limit_s`, a little before the Rust side's time limit, so that line
+      is written.
       Writes OUT_DIR/NAME.msh (gmsh MSH 4.1, for the user) and OUT_DIR/NAME.rodmesh (the hand-off
       file the Rust side reads, see below). The .rodmesh is made from the .msh through meshio, i.e.
       by the very same code path as `convert`. With --no-rodmesh it is not written: the caller reads
@@ -47,8 +53,9 @@ Two commands, both ending with one line of JSON on standard output (progress goe
       a coarse mesh); a later call tries that classification only, then the fallbacks ("local
       refinement" on that classification, the size field's sizes reduced around the patches blamed).
 
-      The 3D mesher is HXT (one thread: deterministic); where it refuses a surface mesh, gmsh's
-      Delaunay with Netgen optimisation is tried on the same classification.
+      The 3D mesher is the policy's `algorithm_3d` (HXT); where it refuses a surface mesh, its
+      `algorithm_3d_fallback` (gmsh's Delaunay with Netgen optimisation) is tried on the same
+      classification.
 
       Second-order nodes are placed at the straight edge midpoints (`Mesh.SecondOrderLinear = 1`):
       snapping them onto a surface reconstructed from an STL (a faceted surface, so nothing is gained in
@@ -57,12 +64,14 @@ Two commands, both ending with one line of JSON on standard output (progress goe
       (and says so in the JSON).
 
   mesh_rod.py mesh-step STEP OUT_DIR --frame OX,OY,OZ,XX,XY,XZ,YX,YY,YZ,ZX,ZY,ZZ --scale S
-                                     [--size 5] [--name NAME] [--size-field FILE] [--no-rodmesh]
+                                     --size MM --policy JSON [--name NAME] [--size-field FILE]
+                                     [--no-rodmesh]
       A STEP solid (the exact B-rep, through gmsh's OpenCASCADE kernel; several solids fused into one
       bonded body) -> curved 10-node tetrahedra whose midside nodes lie on the true surfaces
-      (`Mesh.SecondOrderLinear = 0`); an element whose minimum scaled Jacobian is below 0.1 (a fillet
-      far smaller than the elements) is made straight-sided (`straighten_poor_curved`; gmsh's own
-      high-order optimiser gives another mesh on every run). The solid is first moved
+      (`Mesh.SecondOrderLinear = 0`); an element whose minimum scaled Jacobian is below the policy's
+      `curved_sj_min` (a fillet far smaller than the elements) is made straight-sided
+      (`straighten_poor_curved`; gmsh's own high-order optimiser gives another mesh on every run).
+      The solid is first moved
       into the rod frame in millimetres: p' = S R (p - O), R's rows the frame's x, y, z axes (file
       axes), O the crank pin, S millimetres per file unit; so sizes, the size field and every
       location are rod-frame millimetres, as for an STL. No surface classification and no facet
@@ -70,7 +79,7 @@ Two commands, both ending with one line of JSON on standard output (progress goe
       scaled Jacobian <= 0) is refused with a message, never handed to the solver. Same outputs
       and JSON as `mesh` (`curved` true, `classify_angle_deg` 0).
 
-  mesh_rod.py serve STL --geometry FILE
+  mesh_rod.py serve STL --geometry FILE --policy JSON
       One gmsh session for a whole adaptive sequence of meshes of one STL (rodstudy's stage 3): one
       JSON request per line on standard input, {"size": mm, "size_field": FILE or null, "out_dir":
       DIR, "name": NAME}, one JSON reply per line on standard output, the fields of `mesh`'s (read
@@ -126,38 +135,32 @@ import numpy as np
 
 FORMAT_HEADER = "rodmesh 1"
 
-# Classification settings tried in order, (dihedral angle, curve split angle) in degrees. The first
-# works for most rods; splitting curves at 60 degree kinks helps where tiny faces meet large ones.
-LADDER = [(40.0, 180.0), (40.0, 60.0), (30.0, 180.0), (50.0, 180.0), (30.0, 60.0), (50.0, 60.0)]
+# The meshing policy (`--policy`, JSON), from rodstudy's `src/mesher/policy.rs`, where every meshing
+# decision is written: the classification ladder, the fallbacks and their order, the local
+# refinement's rounds, quality limits, gmsh options and the time limit. This script executes it
+# and defines none of them.
+POLICY: dict = {}
 
-# Strategies that change the surface mesh rather than only its classification, tried in this order
-# when every rung of LADDER fails (`fallback` in the JSON names the one that succeeded):
-#   "local refinement": the classification of the first rung (or the cached one), meshed again
-#       with the mesh size reduced around the patch gmsh names in "overlapping facets on surface A
-#       surface B" (the smaller of the two, by area; a sliver face where a thin feature meets a large
-#       curved one): each round halves the size within reach of that patch's boundary curves and
-#       grows back to the target over twice the target size; up to LOCAL_ROUNDS rounds, never below
-#       LOCAL_MIN_SIZE_MM. gmsh's Delaunay (which names the surfaces; HXT does not); TetGen's "PLC
-#       Error", which names nothing, refines the patch refined last once more.
-#   "STL surface kept": no reparametrisation at all: the STL's own triangles (the surface handed
-#       over, already simplified by the Rust side's quadric error metrics) are the boundary of the
-#       volume mesh; only the interior is meshed at the target size. Exact to the STL, more
-#       elements (the facets set the sizes at the surface). Delaunay + Netgen (HXT's optimiser
-#       takes minutes on a fine boundary).
-# An STL whose shells touch face to face (a rod and its cap as two bodies) is first bonded
-# (`bond_shells`: the coincident faces removed) and both fallbacks mesh the bonded body
-# (`fallback`: "shells bonded, ...").
-FALLBACKS = ("local refinement", "STL surface kept")
-LOCAL_ROUNDS = 12
-LOCAL_MIN_SIZE_MM = 0.1
+# gmsh's codes of the 3D algorithms the policy names
+ALGORITHMS_3D = {"hxt": 10, "delaunay": 1}
 
-# What to try when nothing works (the last line of a total failure).
-WHAT_TO_TRY = ("try: an STL exported at a different chord tolerance (finer or coarser), a STEP export of "
-               "the part (meshed on the exact geometry), another --size, or a volume mesh of your own (--mesh)")
 
-# Smallest acceptable signed inverse condition number of an element (a sliver makes K
-# ill-conditioned: the reactions stop balancing the load to 1e-6).
-MIN_SICN = 0.01
+def policy(key: str):
+    """One entry of the policy; a clear error where the script was called without one."""
+    if not POLICY:
+        raise SystemExit("mesh_rod: no --policy given: rodstudy passes its meshing policy "
+                         "(src/mesher/policy.rs); run the script as `rodstudy pipeline mesh_rod.py ...`")
+    return POLICY[key]
+
+
+def algorithm_code(fallback: bool) -> int:
+    """gmsh's code of the policy's first 3D algorithm, or of its fallback."""
+    return ALGORITHMS_3D[policy("algorithm_3d_fallback" if fallback else "algorithm_3d")]
+
+
+def algorithm_name(code: int) -> str:
+    return {v: k for k, v in ALGORITHMS_3D.items()}.get(code, "?")
+
 
 # VTK/meshio tetra10 edges, in the order of the midside nodes 4..9.
 TET10_EDGES = [(0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3)]
@@ -247,47 +250,17 @@ class ArenaWorker:
 # ---------------------------------------------------------------------------------------------
 
 def gmsh_options(size_mm: float, curved: bool, size_field: bool = False) -> dict:
-    """Every option that influences the mesh, fixed here so that results do not depend on defaults or
-    on a user's gmsh configuration files (which are not read)."""
-    opts = {
-        "General.Terminal": 0,
-        "General.NumThreads": 1,
-        "Mesh.Algorithm": 6,  # Frontal-Delaunay (2D)
-        # HXT (Marot, Pellerin & Remacle 2019): 1.6× faster than Delaunay + Netgen optimisation here,
-        # fewer elements for the same sizes; deterministic with one thread (not with two)
-        "Mesh.Algorithm3D": 10,
-        "Mesh.RandomSeed": 1,
-        "Mesh.MeshSizeMax": size_mm,
-        "Mesh.MeshSizeMin": 0.0,
-        "Mesh.MeshSizeFactor": 1.0,
-        "Mesh.MeshSizeFromCurvature": 0,
-        "Mesh.MeshSizeFromPoints": 0,
-        # sizes of boundary curves extend into the surfaces, not into the volume: a tiny curve (a sliver
-        # face of the STL) refines its surroundings on the surface only
-        "Mesh.MeshSizeExtendFromBoundary": -2,
-        "Mesh.Optimize": 1,
-        "Mesh.OptimizeNetgen": 1,
-        "Mesh.OptimizeThreshold": 0.3,
-        "Mesh.ElementOrder": 2,
-        "Mesh.SecondOrderLinear": 0 if curved else 1,
-        "Mesh.SecondOrderIncomplete": 0,
-        "Mesh.HighOrderOptimize": 0,
-        "Mesh.MshFileVersion": 4.1,
-        "Mesh.Binary": 0,
-        "Mesh.SaveAll": 0,
-    }
-    if size_field:
-        # the background field alone sets the sizes (gmsh's examples/api/adapt_mesh.py)
-        opts["Mesh.MeshSizeExtendFromBoundary"] = 0
-        # the curves' 1D mesh integrates 1/size along each curve to this relative precision; the
-        # default 1e-9 made gmsh evaluate the piecewise-linear field so often that the 1D mesh
-        # took 0.8 s of a 1.5 s mesh (design 1); 1e-6 took 0.23 s on the whole rod, but 0.5-1.1 s
-        # of a half model's later mesh (its cut's long curves); 1e-3 takes 0.15-0.36 s there
-        # (the node spacing along a curve moves by far less than the element sizes the loop
-        # asks for)
-        opts["Mesh.LcIntegrationPrecision"] = 1e-3
-    else:
-        opts["Mesh.LcIntegrationPrecision"] = 1e-9  # gmsh's default (a session's later mesh resets it)
+    """The policy's gmsh options in their order, with the request's size and midside nodes, and
+    the options of a size-field or a uniform mesh set last. No option is left to gmsh's defaults
+    or a user's gmsh configuration files (which are not read)."""
+    opts = dict(policy("gmsh_options"))
+    opts["Mesh.Algorithm3D"] = algorithm_code(False)
+    opts["Mesh.MeshSizeMax"] = size_mm
+    opts["Mesh.SecondOrderLinear"] = 0 if curved else 1
+    opts.update(policy("size_field_options" if size_field else "uniform_options"))
+    unset = [k for k, v in opts.items() if v is None]
+    if unset:
+        raise SystemExit(f"mesh_rod: the policy leaves gmsh options unset: {', '.join(unset)}")
     return opts
 
 
@@ -359,7 +332,7 @@ def tet10_qualities() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 
-def cap_open_cut(plane_tol_rel: float = 1e-6) -> list[int]:
+def cap_open_cut() -> list[int]:
     """The half model's cap: the Rust side hands over the half of a mirror-symmetric rod open at
     its cut (z = c), and the classification leaves the cut as curves that bound one surface each.
     They are chained into loops (outline and holes, nested by their bounding boxes) and each
@@ -376,8 +349,7 @@ def cap_open_cut(plane_tol_rel: float = 1e-6) -> list[int]:
         return []
     boxes = {c: gmsh.model.getBoundingBox(1, c) for c in open_curves}
     zs = [v for b in boxes.values() for v in (b[2], b[5])]
-    # the curves' boxes come from their reparametrisation (seen: 3e-6 mm off the cut's plane on
-    # a rod of 200 mm)
+    plane_tol_rel = policy("cut_plane_tol_rel")
     whole = gmsh.model.getBoundingBox(-1, -1)
     extent = max(whole[3] - whole[0], whole[4] - whole[1], whole[5] - whole[2])
     if max(zs) - min(zs) > plane_tol_rel * extent:
@@ -486,10 +458,11 @@ def mesh_volume(msh_out: pathlib.Path, size_field: pathlib.Path | None, delaunay
     t2 = time.perf_counter()
     tags10, min_sj, min_sicn = tet10_qualities()
     t3 = time.perf_counter()
-    if delaunay is False and min_sicn.min() < MIN_SICN:
+    min_sicn_ok = policy("min_sicn")
+    if delaunay is False and min_sicn.min() < min_sicn_ok:
         # HXT can leave a sliver its optimiser does not remove; the caller retries with
         # Delaunay + Netgen, whose optimiser does
-        raise RuntimeError(f"HXT left a sliver (min SICN {min_sicn.min():.2e} < {MIN_SICN})")
+        raise RuntimeError(f"HXT left a sliver (min SICN {min_sicn.min():.2e} < {min_sicn_ok})")
     written = written_mesh((tags10, min_sj, min_sicn), msh_out, binary)
     phases = {**meshing_phases(log_lines), "qualities": t3 - t2, "write": time.perf_counter() - t3}
     return {
@@ -497,7 +470,7 @@ def mesh_volume(msh_out: pathlib.Path, size_field: pathlib.Path | None, delaunay
         "phases_s": phases,
         "msh_binary": binary,
         "size_field_tetrahedra": size_field_tets,
-        "algorithm_3d": {10: "hxt", 1: "delaunay"}.get(int(gmsh.option.getNumber("Mesh.Algorithm3D")), "?"),
+        "algorithm_3d": algorithm_name(int(gmsh.option.getNumber("Mesh.Algorithm3D"))),
         "seconds_mesh": t2 - t1,
         "gmsh_version": gmsh.option.getString("General.Version"),
     }
@@ -525,7 +498,7 @@ def set_options(size_mm: float, curved: bool, size_field: bool, delaunay: bool) 
     for k, v in gmsh_options(size_mm, curved, size_field).items():
         gmsh.option.setNumber(k, v)
     if delaunay:
-        gmsh.option.setNumber("Mesh.Algorithm3D", 1)
+        gmsh.option.setNumber("Mesh.Algorithm3D", algorithm_code(True))
 
 
 def gmsh_volume_mesh(stl: pathlib.Path, size_mm: float, curved: bool, angle_deg: float,
@@ -575,7 +548,7 @@ def run_attempt_with(stl: pathlib.Path, size: float, curved: bool, angle: float,
                      msh: pathlib.Path, size_field, geometry_in, geometry_out,
                      delaunay: bool, binary: bool = False) -> tuple[dict | None, str]:
     cmd = [sys.executable, str(pathlib.Path(__file__).resolve()), "_attempt", str(stl), str(msh),
-           "--size", repr(size), "--angle", repr(angle), "--curve-angle", repr(curve_angle)]
+           "--size", repr(size), "--angle", repr(angle), "--curve-angle", repr(curve_angle), policy_arg()]
     if curved:
         cmd.append("--curved")
     if delaunay:
@@ -589,20 +562,19 @@ def run_attempt_with(stl: pathlib.Path, size: float, curved: bool, angle: float,
     return run_child(cmd)
 
 
-# The time limit of the whole `mesh` command: the Rust side kills the mesher after
-# RODSTUDY_MESHER_TIMEOUT_S (default 600 s); the children here stop a little before, so that a
-# fallback that runs out of time still ends in a message that says what was tried.
+# The time limit of the whole `mesh` command: the Rust side kills the mesher at its own limit; the
+# policy's `time_limit_s` stops the children here a little before, so that a fallback that runs
+# out of time still ends in a message that says what was tried.
 DEADLINE = [math.inf]
 
 
 def set_deadline(t0: float) -> None:
-    try:
-        limit = float(os.environ.get("RODSTUDY_MESHER_TIMEOUT_S", "600"))
-    except ValueError:
-        limit = 600.0
-    if not (math.isfinite(limit) and limit > 0):
-        limit = 600.0
-    DEADLINE[0] = t0 + limit - max(3.0, 0.05 * limit)
+    DEADLINE[0] = t0 + float(policy("time_limit_s"))
+
+
+def policy_arg() -> str:
+    """The policy as a child's argument."""
+    return "--policy=" + json.dumps(POLICY)
 
 
 def out_of_time() -> bool:
@@ -631,7 +603,7 @@ def run_child(cmd: list) -> tuple[dict | None, str]:
 
 
 # ---------------------------------------------------------------------------------------------
-# fallbacks: a new surface mesh where every classification of LADDER fails (see FALLBACKS)
+# fallbacks: a new surface mesh where every classification of the policy's ladder fails
 # ---------------------------------------------------------------------------------------------
 
 def patch_facts(classified: pathlib.Path) -> tuple[dict, dict]:
@@ -670,8 +642,10 @@ def field_size_near(data: np.ndarray, p: np.ndarray) -> float:
 def add_refinement(refine: dict, size: float, base_field: int | None) -> None:
     """Background field: the smaller of `base_field` (the size field, if any) and, per refined
     patch, its size h within h of the patch's boundary curves, growing linearly to `size` at h +
-    2·size."""
+    g·size (g the policy's `grow_sizes`)."""
     import gmsh
+
+    lr = policy("local_refinement")
 
     F = gmsh.model.mesh.field
     fields = [] if base_field is None else [base_field]
@@ -679,17 +653,18 @@ def add_refinement(refine: dict, size: float, base_field: int | None) -> None:
         curves = sorted({abs(c) for _, c in gmsh.model.getBoundary([(2, tag)], oriented=False)})
         if not curves:
             continue
-        # sample the curves at h/4 (their bounding box diagonal as the length), 20..2000 points each
+        # sample the curves (their bounding box diagonal as the length) as the policy says
         longest = max(math.dist(bb[:3], bb[3:]) for bb in (gmsh.model.getBoundingBox(1, c) for c in curves))
+        samples = math.ceil(lr["samples_per_size"] * longest / h)
         distance = F.add("Distance")
         F.setNumbers(distance, "CurvesList", curves)
-        F.setNumber(distance, "Sampling", int(min(2000, max(20, math.ceil(4.0 * longest / h)))))
+        F.setNumber(distance, "Sampling", int(min(lr["samples_max"], max(lr["samples_min"], samples))))
         threshold = F.add("Threshold")
         F.setNumber(threshold, "InField", distance)
         F.setNumber(threshold, "SizeMin", h)
         F.setNumber(threshold, "SizeMax", size)
         F.setNumber(threshold, "DistMin", h)
-        F.setNumber(threshold, "DistMax", h + 2.0 * size)
+        F.setNumber(threshold, "DistMax", h + lr["grow_sizes"] * size)
         fields.append(threshold)
     if not fields:
         return
@@ -720,7 +695,7 @@ def surfaces_named(error: str, messages: list[str]) -> list[int]:
 def gmsh_local_refinement(stl: pathlib.Path, size_mm: float, angle_deg: float, curve_angle_deg: float,
                           msh_out: pathlib.Path, size_field: pathlib.Path | None,
                           geometry_in: pathlib.Path | None, geometry_out: pathlib.Path | None) -> dict:
-    """The fallback "local refinement" (see FALLBACKS)."""
+    """The fallback "local refinement" (the policy's `fallbacks` and `local_refinement`)."""
     import gmsh
 
     t0 = time.perf_counter()
@@ -738,12 +713,13 @@ def gmsh_local_refinement(stl: pathlib.Path, size_mm: float, angle_deg: float, c
             gmsh.write(str(classified))
         finally:
             gmsh.finalize()
+    lr = policy("local_refinement")
     areas, centroids = patch_facts(classified)
     field_data = read_size_field(size_field) if size_field is not None else None
     refine: dict[int, float] = {}
     errors = []
     last = None
-    for rounds in range(LOCAL_ROUNDS + 1):
+    for rounds in range(lr["rounds"] + 1):
         gmsh.initialize(["mesh_rod"], readConfigFiles=False, interruptible=False)
         try:
             # Delaunay: its errors name the surfaces
@@ -773,12 +749,12 @@ def gmsh_local_refinement(stl: pathlib.Path, size_mm: float, angle_deg: float, c
                 if not named:
                     raise RuntimeError(f"local refinement: {error} (no surface named to refine)")
                 current = {t: refine.get(t, start_size(t, size_mm, field_data, centroids)) for t in named}
-                open_ = [t for t in named if current[t] * 0.5 >= LOCAL_MIN_SIZE_MM]
+                open_ = [t for t in named if current[t] * lr["factor"] >= lr["min_size_mm"]]
                 if not open_:
                     raise RuntimeError(f"local refinement: {error} (sizes there already at "
-                                       f"{LOCAL_MIN_SIZE_MM} mm)")
+                                       f"{lr['min_size_mm']} mm)")
                 patch = min(open_, key=lambda t: (areas[t], t))
-                refine[patch] = current[patch] * 0.5
+                refine[patch] = current[patch] * lr["factor"]
                 last = patch
                 continue
             t2 = time.perf_counter()
@@ -786,7 +762,7 @@ def gmsh_local_refinement(stl: pathlib.Path, size_mm: float, angle_deg: float, c
                 **written_mesh(tet10_qualities(), msh_out),
                 "surface_patches": patches,
                 "size_field_tetrahedra": size_field_tets,
-                "algorithm_3d": "delaunay",
+                "algorithm_3d": policy("algorithm_3d_fallback"),
                 "geometry_reused": geometry_in is not None,
                 "fallback": "local refinement",
                 "fallback_detail": {
@@ -801,7 +777,7 @@ def gmsh_local_refinement(stl: pathlib.Path, size_mm: float, angle_deg: float, c
             }
         finally:
             gmsh.finalize()
-    raise RuntimeError(f"local refinement: still failing after {LOCAL_ROUNDS} rounds: {errors[-1]}")
+    raise RuntimeError(f"local refinement: still failing after {lr['rounds']} rounds: {errors[-1]}")
 
 
 def start_size(tag: int, size_mm: float, field_data, centroids: dict) -> float:
@@ -825,7 +801,7 @@ def has_open_edges() -> bool:
 
 def gmsh_surface_kept(stl: pathlib.Path, size_mm: float, msh_out: pathlib.Path,
                       size_field: pathlib.Path | None) -> dict:
-    """The fallback "STL surface kept" (see FALLBACKS)."""
+    """The fallback "STL surface kept" (the policy's `fallbacks`)."""
     import gmsh
 
     t0 = time.perf_counter()
@@ -833,7 +809,7 @@ def gmsh_surface_kept(stl: pathlib.Path, size_mm: float, msh_out: pathlib.Path,
     try:
         for k, v in gmsh_options(size_mm, False, size_field is not None).items():
             gmsh.option.setNumber(k, v)
-        gmsh.option.setNumber("Mesh.Algorithm3D", 1)
+        gmsh.option.setNumber("Mesh.Algorithm3D", algorithm_code(True))
         gmsh.model.add("rod")
         gmsh.merge(str(stl))
         surfaces = [tag for _, tag in gmsh.model.getEntities(2)]
@@ -853,7 +829,7 @@ def gmsh_surface_kept(stl: pathlib.Path, size_mm: float, msh_out: pathlib.Path,
             **written_mesh(tet10_qualities(), msh_out),
             "surface_patches": 0,
             "size_field_tetrahedra": size_field_tets,
-            "algorithm_3d": "delaunay",
+            "algorithm_3d": policy("algorithm_3d_fallback"),
             "geometry_reused": False,
             "fallback": "STL surface kept",
             "fallback_detail": {"boundary_triangles": int(boundary)},
@@ -902,9 +878,9 @@ def bond_shells(stl: pathlib.Path, out: pathlib.Path) -> int:
 
 def run_fallback(name: str, stl: pathlib.Path, size: float, angle: float, curve_angle: float,
                  msh: pathlib.Path, size_field, geometry_in, geometry_out) -> tuple[dict | None, str]:
-    """One fallback of FALLBACKS in a child process."""
+    """One fallback of the policy's `fallbacks` in a child process."""
     cmd = [sys.executable, str(pathlib.Path(__file__).resolve()), "_fallback", name, str(stl), str(msh),
-           "--size", repr(size), "--angle", repr(angle), "--curve-angle", repr(curve_angle)]
+           "--size", repr(size), "--angle", repr(angle), "--curve-angle", repr(curve_angle), policy_arg()]
     for flag, value in (("--size-field", size_field), ("--geometry-in", geometry_in),
                         ("--geometry-out", geometry_out)):
         if value is not None:
@@ -944,8 +920,7 @@ def cmd_mesh(args) -> dict:
         raise SystemExit(f"mesh_rod: no such size field file: {size_field}")
     geometry = pathlib.Path(args.geometry) if args.geometry else None
     meta = geometry.with_name(geometry.name + ".json") if geometry else None
-    ladder = [(args.angle, args.curve_angle)] if args.angle is not None or args.curve_angle is not None else LADDER
-    ladder = [(a if a is not None else LADDER[0][0], c if c is not None else LADDER[0][1]) for a, c in ladder]
+    ladder = [tuple(rung) for rung in policy("ladder")]
     cached = None
     if geometry is not None and geometry.is_file() and meta.is_file():
         cached = json.loads(meta.read_text())
@@ -989,7 +964,7 @@ def cmd_mesh(args) -> dict:
         if out_of_time():
             break
     if info is None:
-        # the surface itself is meshed differently (FALLBACKS); the classification is the cached
+        # the surface itself is meshed differently (the policy's fallbacks); the classification is the cached
         # one or the ladder's first
         angle, curve_angle = ladder[0]
         # shells that touch face to face are bonded first (their common faces removed)
@@ -999,7 +974,7 @@ def cmd_mesh(args) -> dict:
             log(f"{stl.name}: {pairs} pairs of coincident opposite triangles (shells touching face to face) "
                 "removed: the fallbacks mesh the bonded body")
         surface = bonded if pairs else stl
-        for fallback in FALLBACKS:
+        for fallback in policy("fallbacks"):
             reuse = cached is not None and not pairs
             geo_out = None
             if fallback == "local refinement" and not reuse:
@@ -1032,10 +1007,10 @@ def cmd_mesh(args) -> dict:
                  f"last error: {ladder_errors[-1] if ladder_errors else 'none'})"]
         tried += [f"{f['fallback']} ({'' if f['error'].startswith('not tried') else 'error: '}{f['error']})"
                   for f in failed if "fallback" in f]
-        tried += [f"{fb} (not tried: the mesher's time limit)" for fb in FALLBACKS
+        tried += [f"{fb} (not tried: the mesher's time limit)" for fb in policy("fallbacks")
                   if not any(f.get("fallback", "").endswith(fb) for f in failed)]
         raise SystemExit(f"mesh_rod: error: gmsh could not mesh {stl} at {args.size} mm; tried "
-                         + "; ".join(tried) + f"; {WHAT_TO_TRY}")
+                         + "; ".join(tried) + f"; {policy('what_to_try')}")
     info.update({
         "stl": str(stl),
         "msh": str(msh),
@@ -1139,7 +1114,7 @@ def served_mesh(request: dict, stl: pathlib.Path, geometry: pathlib.Path, state:
     meta = geometry.with_name(geometry.name + ".json")
     cached = cached_classification(geometry)
     reused = cached is not None
-    angle, curve_angle = cached if reused else LADDER[0]
+    angle, curve_angle = cached if reused else tuple(policy("ladder")[0])
     geo_out = None if reused else geometry.with_name(geometry.name + ".tmp.msh")
     log(f"{stl.name}: meshing at {size} mm (classification {angle:g} deg, curves {curve_angle:g} deg)"
         + (", size field" if size_field else "") + (", classified surface reused" if reused else "")
@@ -1209,7 +1184,7 @@ def gmsh_step_mesh(step: pathlib.Path, frame: list, scale: float, size_mm: float
         gmsh.option.setNumber("Geometry.OCCScaling", 1.0)
         gmsh.option.setString("Geometry.OCCTargetUnit", "MM")
         if delaunay:
-            gmsh.option.setNumber("Mesh.Algorithm3D", 1)
+            gmsh.option.setNumber("Mesh.Algorithm3D", algorithm_code(True))
         gmsh.model.add("rod")
         occ = gmsh.model.occ
         ents = occ.importShapes(str(step))
@@ -1234,14 +1209,14 @@ def gmsh_step_mesh(step: pathlib.Path, frame: list, scale: float, size_mm: float
             raise RuntimeError(f"{step}: {int((min_sj <= 0).sum())} element(s) inverted even with straight sides "
                                f"(min scaled Jacobian {min_sj.min():.3g}): not solved on; try another element "
                                f"size, or repair the STEP where faces meet at a sliver")
-        if delaunay is False and min_sicn.min() < MIN_SICN:
-            raise RuntimeError(f"HXT left a sliver (min SICN {min_sicn.min():.2e} < {MIN_SICN})")
+        if delaunay is False and min_sicn.min() < policy("min_sicn"):
+            raise RuntimeError(f"HXT left a sliver (min SICN {min_sicn.min():.2e} < {policy('min_sicn')})")
         return {
             **written_mesh((tags10, min_sj, min_sicn), msh_out),
             "solids": len(solids),
             **straightened,
             "size_field_tetrahedra": size_field_tets,
-            "algorithm_3d": "delaunay" if delaunay else "hxt",
+            "algorithm_3d": algorithm_name(algorithm_code(delaunay)),
             "seconds_geometry": t1 - t0,
             "seconds_mesh": t2 - t1,
             "gmsh_version": gmsh.option.getString("General.Version"),
@@ -1252,12 +1227,9 @@ def gmsh_step_mesh(step: pathlib.Path, frame: list, scale: float, size_mm: float
 
 # gmsh's 10-node tetrahedron: midside node 4 + k on the edge GMSH_TET10_EDGES[k] (manual, "Node ordering")
 GMSH_TET10_EDGES = ((0, 1), (1, 2), (2, 0), (3, 0), (3, 2), (3, 1))
-# the scaled Jacobian below which a curved element is made straight-sided (gmsh's own target for its
-# high-order optimiser, `Mesh.HighOrderThresholdMin`)
-CURVED_SJ_MIN = 0.1
 
 
-def straighten_poor_curved(threshold: float = CURVED_SJ_MIN) -> dict:
+def straighten_poor_curved() -> dict:
     """Makes the curved 10-node tetrahedra whose minimum scaled Jacobian is below `threshold`
     straight-sided: each midside node of such an element goes back to the midpoint of its edge's
     corners (the neighbours sharing the edge share that straight edge), in rounds until no poor
@@ -1265,8 +1237,11 @@ def straighten_poor_curved(threshold: float = CURVED_SJ_MIN) -> dict:
     which the mesher made valid. Deterministic: the same mesh gives the same result on every run,
     where gmsh's high-order optimiser does not. Where the elements are too coarse for a fillet
     (an R1 fillet under 4 mm elements) the fillet is then meshed by its chords, as from an STL;
-    the adaptive loop's smaller elements there are curved again. Returns the counts."""
+    the adaptive loop's smaller elements there are curved again. `threshold`: the policy's
+    `curved_sj_min`. Returns the counts."""
     import gmsh
+
+    threshold = policy("curved_sj_min")
 
     types, tags, conn = gmsh.model.mesh.getElements(3)
     if len(types) != 1 or types[0] != 11:
@@ -1319,7 +1294,7 @@ def cmd_mesh_step(args) -> dict:
             info = gmsh_step_mesh(step, args.frame, args.scale, args.size, msh, size_field, delaunay)
             break
         except Exception as e:  # gmsh raises Exception with its last error
-            failed.append({"algorithm_3d": "delaunay" if delaunay else "hxt", "error": str(e)})
+            failed.append({"algorithm_3d": algorithm_name(algorithm_code(delaunay)), "error": str(e)})
             log(f"  failed: {e}")
     if info is None:
         raise SystemExit(f"mesh_rod: gmsh could not mesh {step} at {args.size} mm: "
@@ -1342,7 +1317,7 @@ def cmd_attempt(args) -> dict:
 
 
 def cmd_fallback(args) -> dict:
-    """Internal: one fallback of FALLBACKS, writing the .msh; used by `mesh` in a child process."""
+    """Internal: one fallback of the policy's, writing the .msh; used by `mesh` in a child process."""
     path = lambda v: pathlib.Path(v) if v else None  # noqa: E731
     if args.strategy == "local refinement":
         return gmsh_local_refinement(pathlib.Path(args.stl), args.size, args.angle, args.curve_angle,
@@ -1350,7 +1325,8 @@ def cmd_fallback(args) -> dict:
                                      path(args.geometry_out))
     if args.strategy == "STL surface kept":
         return gmsh_surface_kept(pathlib.Path(args.stl), args.size, pathlib.Path(args.msh), path(args.size_field))
-    raise SystemExit(f"mesh_rod: unknown fallback {args.strategy!r}")
+    raise SystemExit(f"mesh_rod: unknown fallback {args.strategy!r} (this script knows 'local refinement' "
+                     "and 'STL surface kept')")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -1431,14 +1407,10 @@ def main(argv=None) -> int:
     pm = sub.add_parser("mesh", help="STL -> tet10 volume mesh (.msh + .rodmesh)")
     pm.add_argument("stl")
     pm.add_argument("out_dir")
-    pm.add_argument("--size", type=float, default=5.0, help="target element size, mm (default 5)")
+    pm.add_argument("--size", type=float, required=True, help="target element size, mm")
     pm.add_argument("--name", help="output base name (default: the STL's stem)")
     pm.add_argument("--curved", action="store_true",
                     help="try midside nodes on the surface; fall back to straight if any element inverts")
-    pm.add_argument("--angle", type=float,
-                    help="classifySurfaces: dihedral angle (degrees) splitting patches (default: the ladder)")
-    pm.add_argument("--curve-angle", type=float,
-                    help="classifySurfaces: angle (degrees) splitting curves (default: the ladder)")
     pm.add_argument("--size-field", help="local size map: raw float64, 16 per tetrahedron (see above)")
     pm.add_argument("--geometry", help="cache of the classified surface (written once, then reused)")
     pm.add_argument("--no-rodmesh", action="store_true",
@@ -1456,7 +1428,7 @@ def main(argv=None) -> int:
     pa.add_argument("--delaunay", action="store_true")
     pa.add_argument("--binary", action="store_true")
     pf = sub.add_parser("_fallback", help=argparse.SUPPRESS)
-    pf.add_argument("strategy", choices=FALLBACKS)
+    pf.add_argument("strategy")
     pf.add_argument("stl")
     pf.add_argument("msh")
     pf.add_argument("--size", type=float, required=True)
@@ -1472,7 +1444,7 @@ def main(argv=None) -> int:
                     help="origin (3) and the rod frame's x, y, z axes (3 each), file coordinates, "
                          "12 numbers separated by commas")
     ps.add_argument("--scale", type=float, required=True, help="millimetres per file unit")
-    ps.add_argument("--size", type=float, default=5.0, help="target element size, mm (default 5)")
+    ps.add_argument("--size", type=float, required=True, help="target element size, mm")
     ps.add_argument("--name", help="output base name (default: the STEP's stem)")
     ps.add_argument("--size-field", help="local size map: raw float64, 16 per tetrahedron (see above)")
     ps.add_argument("--no-rodmesh", action="store_true",
@@ -1484,7 +1456,13 @@ def main(argv=None) -> int:
     pv = sub.add_parser("serve", help="one gmsh session for an adaptive sequence: JSON requests on stdin")
     pv.add_argument("stl")
     pv.add_argument("--geometry", required=True, help="the classified-surface cache, as `mesh --geometry`")
+    for p in (pm, pa, pf, ps, pv):
+        p.add_argument("--policy", type=json.loads, required=True,
+                       help="the meshing policy, JSON (rodstudy's src/mesher/policy.rs; "
+                            "`rodstudy pipeline mesh_rod.py ...` adds it)")
     args = ap.parse_args(argv)
+    if getattr(args, "policy", None) is not None:
+        POLICY.update(args.policy)
     fixed_allocator()
     if args.cmd == "serve":
         cmd_serve(args)

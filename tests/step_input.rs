@@ -627,6 +627,7 @@ fn a_steps_curved_mesh_is_the_same_on_every_run() {
             .arg(&out)
             .args(["--frame", "0,0,0,1,0,0,0,1,0,0,0,1", "--scale", "1"])
             .args(["--size", "4", "--no-rodmesh"])
+            .arg(rodstudy::mesher::MeshPolicy::standard().arg())
             .output()
             .unwrap();
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));

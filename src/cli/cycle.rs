@@ -3,7 +3,7 @@
 //! factor, on the mesh stage 3 ends on.
 
 use super::mesh_args::MeshArgs;
-use crate::config::StudyConfig;
+use super::settings::DesignSettings;
 use crate::mechanism::Method;
 use crate::report::fields::{write_cycle_fields, write_fem_fields};
 use crate::stages;
@@ -44,8 +44,8 @@ struct CycleJson<'a> {
 }
 
 pub fn run(args: CycleArgs) -> Result<i32> {
-    let config = StudyConfig::load(args.config.as_deref())?;
-    let mode = args.mesh.mode(&config)?;
+    let DesignSettings { config, mode, .. } =
+        DesignSettings::resolve(args.config.as_deref(), &args.mesh, None)?;
     let design = stages::mass::load(&args.design)?;
     let mass = stages::mass::mass(&design)?;
     let (dynamics, _) = stages::dynamics::dynamics_with(

@@ -2,12 +2,12 @@
 //! [--refine 8,5,3.5]`
 
 use super::mesh_args::MeshArgs;
+use super::settings::DesignSettings;
 use crate::config::StudyConfig;
 use crate::stages;
 use crate::stages::fem::FemLoads;
-use crate::stages::fem::MeshMode;
 use crate::stages::records::{DesignFem, LoadedDesign};
-use anyhow::{Result, bail};
+use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -60,13 +60,12 @@ pub(crate) fn peak_force(design: &LoadedDesign, config: &StudyConfig) -> Result<
 }
 
 pub fn run(args: FemArgs) -> Result<i32> {
-    let config = StudyConfig::load(args.config.as_deref())?;
-    let mode = args.mesh.mode(&config)?;
+    let settings = DesignSettings::resolve(args.config.as_deref(), &args.mesh, args.force)?;
+    let config = &settings.config;
     let design = stages::mass::load(&args.design)?;
-    let design_loads = FemLoads::of_design(&design, &config)?;
-    let loads = match args.force {
-        Some(f) if f.is_finite() && f > 0.0 => design_loads.with_force(f),
-        Some(f) => bail!("--force must be a positive number of newtons, got {f}"),
+    let design_loads = FemLoads::of_design(&design, config)?;
+    let loads = match settings.force_n {
+        Some(f) => design_loads.with_force(f),
         None => {
             eprintln!(
                 "load: the design's peak pin force, {:.1} N",
@@ -77,13 +76,10 @@ pub fn run(args: FemArgs) -> Result<i32> {
     };
     let force = loads.force_n;
     if let Some(sizes) = &args.refine {
-        return refine(&args, &design, &config, &loads, sizes);
+        return refine(&args, &design, &settings, &loads, sizes);
     }
     if args.convergence {
-        let target = match &mode {
-            MeshMode::Adaptive(a) => a.target_error,
-            _ => 0.03,
-        };
+        let target = settings.target_error();
         let c = if args.replot {
             crate::bench::fem_convergence::replot(&args.out)?
         } else {
@@ -111,19 +107,18 @@ pub fn run(args: FemArgs) -> Result<i32> {
     // pressure trace, where stage 3 computes and judges it itself) or the peak pin force (F_x);
     // stage 3 runs it beside its geometry check, on the factorised K of the final mesh (the same
     // supports)
-    let engine = config.engine.pressure_trace.is_some();
-    let buckling_n = match (args.no_buckling, args.force) {
+    let buckling_n = match (args.no_buckling, settings.force_n) {
         (true, _) => None,
         (false, Some(f)) => Some(f),
-        (false, None) if engine => None,
+        (false, None) if settings.engine => None,
         (false, None) => Some(loads.compression_n),
     };
     let mut outcome = stages::fem::fem_and_buckling(
         &design,
         &loads,
-        &config,
+        config,
         &args.out.join("mesh"),
-        &mode,
+        &settings.mode,
         false,
         buckling_n,
     )?;
@@ -332,13 +327,18 @@ fn print_result(d: &DesignFem) {
 fn refine(
     args: &FemArgs,
     design: &LoadedDesign,
-    config: &StudyConfig,
+    settings: &DesignSettings,
     loads: &FemLoads,
     sizes: &[f64],
 ) -> Result<i32> {
     let force = loads.force_n;
-    let study =
-        stages::fem::fem_refinement(design, loads, config, &args.out.join("refinement"), sizes)?;
+    let study = stages::fem::fem_refinement(
+        design,
+        loads,
+        &settings.config,
+        &args.out.join("refinement"),
+        sizes,
+    )?;
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&study)?);
         return Ok(0);
@@ -348,7 +348,7 @@ fn refine(
          bore and the sharp edges left out)\n",
         args.design.display(),
         force,
-        if config.engine.pressure_trace.is_some() {
+        if settings.engine {
             " (F_x; F_y carries the engine's largest pin force across the rod)"
         } else {
             " (both cases)"

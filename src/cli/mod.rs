@@ -34,6 +34,7 @@ mod mass;
 mod merge;
 mod mesh_args;
 mod pipeline;
+mod settings;
 mod solve;
 mod study;
 mod sweep;

@@ -36,10 +36,23 @@ pub fn run(args: PipelineArgs) -> Result<i32> {
         bail!("{}: no such pipeline script", script.display());
     }
     let python = python()?;
-    let status = Command::new(&python)
-        .arg(&script)
-        .args(&args.args)
+    let mut command = Command::new(&python);
+    command.arg(&script).args(&args.args);
+    if needs_policy(&args.script, &args.args) {
+        command.arg(crate::mesher::MeshPolicy::standard().arg());
+    }
+    let status = command
         .status()
         .with_context(|| format!("cannot run {}", python.display()))?;
     Ok(status.code().unwrap_or(2))
+}
+
+/// Whether a call of the mesher script makes meshes (`mesh`, `mesh-step`, `serve`) without a
+/// policy of its own: it then gets rodstudy's ([`crate::mesher::policy`]), as a study's meshes do.
+fn needs_policy(script: &str, args: &[String]) -> bool {
+    script == crate::mesher::MESHER_SCRIPT
+        && args
+            .first()
+            .is_some_and(|c| ["mesh", "mesh-step", "serve"].contains(&c.as_str()))
+        && !args.iter().any(|a| a.starts_with("--policy"))
 }

@@ -331,6 +331,28 @@ pub const MIN_MESH_SIZE_MM: f64 = 0.01;
 /// Most cycle instants (0.01° apart over a revolution).
 pub const MAX_INSTANTS: usize = 36_000;
 
+/// An element size setting, mm: a number between [`MIN_MESH_SIZE_MM`] and [`MAX_LENGTH_MM`]; the
+/// one rule of `[fem]`'s sizes and of `--size`, whose `name` the message gives.
+pub fn check_element_size(name: &str, v: f64) -> Result<()> {
+    if !(v.is_finite() && (MIN_MESH_SIZE_MM..=MAX_LENGTH_MM).contains(&v)) {
+        bail!(
+            "{name} = {v:e} is out of range: it must be a number of mm between {MIN_MESH_SIZE_MM} \
+             and {MAX_LENGTH_MM:e} (finer elements resolve nothing of a rod and take gmsh beyond \
+             its time limit)"
+        );
+    }
+    Ok(())
+}
+
+/// The target estimated relative error of adaptive refinement: in [0, 1), 0 for one fixed mesh;
+/// the one rule of `fem.target_error` and of `--target-error`, whose `name` the message gives.
+pub fn check_target_error(name: &str, t: f64) -> Result<()> {
+    if !(t.is_finite() && (0.0..1.0).contains(&t)) {
+        bail!("{name} must lie in [0, 1) (0: one fixed mesh), got {t}");
+    }
+    Ok(())
+}
+
 /// Refuses the first `(key, value, max, unit)` whose value exceeds its max, naming the key.
 fn check_upper_bounds(bounds: &[(&str, f64, f64, &str)]) -> Result<()> {
     for &(key, v, max, unit) in bounds {
@@ -502,12 +524,7 @@ impl StudyConfig {
             ("fem.min_size_mm", self.fem.min_size_mm),
             ("fem.step_min_size_mm", self.fem.step_min_size_mm),
         ] {
-            if v < MIN_MESH_SIZE_MM {
-                bail!(
-                    "`{key}` = {v:e} is out of range: it must be at least {MIN_MESH_SIZE_MM} mm \
-                     (finer elements resolve nothing of a rod and take gmsh beyond its time limit)"
-                );
-            }
+            check_element_size(&format!("`{key}`"), v)?;
         }
         let e = self.fem.youngs_modulus_pa;
         if !(1e9..=1e12).contains(&e) {
@@ -521,10 +538,7 @@ impl StudyConfig {
                 }
             );
         }
-        let t = self.fem.target_error;
-        if !(t.is_finite() && (0.0..1.0).contains(&t)) {
-            bail!("`fem.target_error` must lie in [0, 1) (0: one fixed mesh), got {t}");
-        }
+        check_target_error("`fem.target_error`", self.fem.target_error)?;
         if self.fem.max_iterations == 0 || self.fem.max_dofs < 1000 {
             bail!("`fem.max_iterations` must be at least 1 and `fem.max_dofs` at least 1000");
         }

@@ -138,9 +138,18 @@ impl<'a> RodSurface<'a> {
         let margin = 1e-3 * self.extent;
         let mut on_axis = Vec::new();
         let mut across_plane = Vec::new();
-        for t in 0..self.mesh.triangles.len() {
-            let c = self.mesh.corners(t);
-            let d = c.map(|p| p - centre);
+        // each vertex's coordinates in the frame (u, v, axis) at the centre once: a vertex is a
+        // corner of about six triangles
+        let frame: Vec<[f64; 3]> = self
+            .mesh
+            .vertices
+            .iter()
+            .map(|p| {
+                let d = p - centre;
+                [d.dot(&u), d.dot(&v), d.dot(&axis)]
+            })
+            .collect();
+        for (t, ids) in self.mesh.triangles.iter().enumerate() {
             let (mut ulo, mut uhi, mut vlo, mut vhi, mut wlo, mut whi) = (
                 f64::INFINITY,
                 f64::NEG_INFINITY,
@@ -149,8 +158,8 @@ impl<'a> RodSurface<'a> {
                 f64::INFINITY,
                 f64::NEG_INFINITY,
             );
-            for p in &d {
-                let (pu, pv, pw) = (p.dot(&u), p.dot(&v), p.dot(&axis));
+            for &i in ids {
+                let [pu, pv, pw] = frame[i as usize];
                 ulo = ulo.min(pu);
                 uhi = uhi.max(pu);
                 vlo = vlo.min(pv);
@@ -159,10 +168,10 @@ impl<'a> RodSurface<'a> {
                 whi = whi.max(pw);
             }
             if ulo <= margin && uhi >= -margin && vlo <= margin && vhi >= -margin {
-                on_axis.push(c);
+                on_axis.push(self.mesh.corners(t));
             }
             if wlo <= 0.0 && whi >= 0.0 {
-                across_plane.push(c);
+                across_plane.push(self.mesh.corners(t));
             }
         }
         let hits = |dir: Vector3<f64>, tris: &[[Vector3<f64>; 3]]| -> Vec<f64> {

@@ -2,11 +2,11 @@
 //!
 //! The interpreter path is an argument (the caller manages the project's virtual environment).
 //! The script prints progress on standard error and one JSON line on standard output, which is
-//! parsed into [`MeshReport`]. gmsh's remeshing of a surface reconstructed from an STL can fail where
-//! tiny faces meet large ones; the script then tries a fixed ladder of classification settings
-//! (reported in `classify_angle_deg`, `curve_angle_deg`, `failed_attempts`), and where every
-//! setting fails, fallbacks that mesh the surface differently (`fallback`), so the result stays
-//! deterministic.
+//! parsed into [`MeshReport`]. Every call carries the meshing policy ([`MeshPolicy`]). gmsh's
+//! remeshing of a surface reconstructed from an STL can fail where tiny faces meet large ones; the
+//! script then tries the policy's ladder of classification settings (reported in
+//! `classify_angle_deg`, `curve_angle_deg`, `failed_attempts`), and where every setting fails, its
+//! fallbacks that mesh the surface differently (`fallback`), so the result stays deterministic.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -14,6 +14,7 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
+use super::policy::MeshPolicy;
 use super::rodmesh::read_rodmesh;
 use crate::fem::TetMesh;
 use crate::fem::error::{FemError, Result};
@@ -47,7 +48,7 @@ pub struct MeshReport {
     #[serde(default)]
     pub failed_attempts: Vec<serde_json::Value>,
     /// The fallback that made the mesh where every classification setting failed: `local
-    /// refinement` or `STL surface kept` (`mesh_rod.py`'s `FALLBACKS`); `None` for the usual mesh.
+    /// refinement` or `STL surface kept` ([`super::policy::FALLBACKS`]); `None` for the usual mesh.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fallback: Option<String>,
     /// The gmsh mesh written (MSH 4.1).
@@ -73,7 +74,8 @@ pub struct MeshReport {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub phases_s: Option<MeshPhases>,
     /// A STEP's curved mesh: the elements made straight-sided because their scaled Jacobian was
-    /// below 0.1 (`mesh_rod.py`'s `straighten_poor_curved`); `None` for an STL's mesh.
+    /// below [`MeshPolicy::curved_sj_min`] (`mesh_rod.py`'s `straighten_poor_curved`); `None` for
+    /// an STL's mesh.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub curved_elements_straightened: Option<usize>,
 }
@@ -234,12 +236,14 @@ pub fn mesh_stl_with(
     }
     std::fs::create_dir_all(out_dir).map_err(|e| FemError::io(out_dir, e))?;
     let size = format!("{size_mm}");
+    let policy = MeshPolicy::standard().arg();
     let mut args: Vec<&std::ffi::OsStr> = vec![
         "mesh".as_ref(),
         stl.as_os_str(),
         out_dir.as_os_str(),
         "--size".as_ref(),
         size.as_ref(),
+        policy.as_ref(),
     ];
     if let Some(f) = request.size_field {
         args.extend(["--size-field".as_ref(), f.as_os_str()]);
@@ -294,11 +298,13 @@ pub fn mesh_step_with(
     // one argument `--frame=…`: a value that starts with "-" would read as an option
     let frame = format!("--frame={frame}");
     let (size, scale) = (format!("{size_mm}"), format!("{:?}", step.scale));
+    let policy = MeshPolicy::standard().arg();
     let mut args: Vec<&std::ffi::OsStr> = vec![
         "mesh-step".as_ref(),
         step.step.as_os_str(),
         out_dir.as_os_str(),
         frame.as_ref(),
+        policy.as_ref(),
     ];
     let tail: [&std::ffi::OsStr; 4] = [
         "--scale".as_ref(),

@@ -48,6 +48,7 @@ impl GmshSession {
             .arg(stl)
             .arg("--geometry")
             .arg(geometry)
+            .arg(super::policy::MeshPolicy::standard().arg())
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())

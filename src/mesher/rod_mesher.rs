@@ -196,7 +196,7 @@ impl GmshRodMesher {
 impl Mesher for GmshRodMesher {
     /// The mesh the adaptive loop asks for, in `work_dir/adapt<iteration>`. gmsh can fail to
     /// remesh a faceted surface coarsely where thin features meet ("overlapping facets"); the
-    /// mesher then tries its fallbacks (`mesh_rod.py`'s `FALLBACKS`), and a mesh that still fails
+    /// mesher then tries its fallbacks ([`super::policy::FALLBACKS`]), and a mesh that still fails
     /// is asked again with all sizes × 0.8, twice at most.
     fn last_phases(&self) -> Option<MeshPhases> {
         self.last_report.as_ref().and_then(|r| r.phases_s)

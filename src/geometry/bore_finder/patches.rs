@@ -114,8 +114,8 @@ pub fn smooth_patches_through(mesh: &IndexedMesh, seeds: &[u32]) -> Vec<u32> {
         }
     };
     let cos_max = SMOOTH_ANGLE_DEG.to_radians().cos();
+    // every triangle seen is queued once and walked from: the patches are the triangles seen
     let mut seen = vec![false; n];
-    let mut patch: Vec<u32> = Vec::new();
     let mut queue: Vec<u32> = Vec::new();
     for &s in seeds {
         if !seen[s as usize] {
@@ -124,7 +124,6 @@ pub fn smooth_patches_through(mesh: &IndexedMesh, seeds: &[u32]) -> Vec<u32> {
         }
     }
     while let Some(t) = queue.pop() {
-        patch.push(t);
         let [a, b, c] = mesh.triangles[t as usize];
         let nt = normal(t);
         for (i, j) in [(a, b), (b, c), (c, a)] {
@@ -142,6 +141,5 @@ pub fn smooth_patches_through(mesh: &IndexedMesh, seeds: &[u32]) -> Vec<u32> {
             }
         }
     }
-    patch.sort_unstable();
-    patch
+    (0..n as u32).filter(|&t| seen[t as usize]).collect()
 }

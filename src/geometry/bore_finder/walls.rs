@@ -249,8 +249,23 @@ pub(super) fn on_cylinder(
         .collect()
 }
 
-/// The distinct vertices of some triangles.
+/// The distinct vertices of some triangles, in the order of their indices. Many triangles (a
+/// sixteenth of the vertex count or more: a wall) are marked on a table of the vertices; a few
+/// (a ring of a growth) are sorted.
 pub(super) fn patch_vertices(mesh: &IndexedMesh, triangles: &[u32]) -> Vec<Vector3<f64>> {
+    if 16 * triangles.len() >= mesh.vertices.len() {
+        let mut used = vec![false; mesh.vertices.len()];
+        for &t in triangles {
+            for v in mesh.triangles[t as usize] {
+                used[v as usize] = true;
+            }
+        }
+        return used
+            .iter()
+            .zip(&mesh.vertices)
+            .filter_map(|(&u, p)| u.then_some(*p))
+            .collect();
+    }
     let mut ids: Vec<u32> = triangles
         .iter()
         .flat_map(|&t| mesh.triangles[t as usize])
@@ -273,14 +288,30 @@ pub(super) fn describe_wall(
         let d = p - cyl.origin;
         d.dot(&v).atan2(d.dot(&u)).rem_euclid(TAU)
     };
+    // each vertex's angle once (a vertex is a corner of about six triangles); a few triangles of
+    // a large mesh (a wall of the whole part) take theirs as they come
+    let mut angles = if 16 * triangles.len() >= mesh.vertices.len() {
+        vec![f64::NAN; mesh.vertices.len()]
+    } else {
+        Vec::new()
+    };
+    let mut angle_of = |i: u32| match angles.get_mut(i as usize) {
+        Some(slot) if slot.is_nan() => {
+            *slot = angle(mesh.vertices[i as usize]);
+            *slot
+        }
+        Some(slot) => *slot,
+        None => angle(mesh.vertices[i as usize]),
+    };
     let mut intervals: Vec<(f64, f64)> = Vec::with_capacity(triangles.len() + 8);
     let (mut wlo, mut whi) = (f64::INFINITY, f64::NEG_INFINITY);
     for &t in triangles {
+        let ids = mesh.triangles[t as usize];
         let c = mesh.corners(t as usize);
-        let t0 = angle(c[0]);
+        let t0 = angle_of(ids[0]);
         let (mut lo, mut hi) = (0.0f64, 0.0f64);
-        for p in &c[1..] {
-            let mut d = angle(*p) - t0;
+        for &i in &ids[1..] {
+            let mut d = angle_of(i) - t0;
             if d > PI {
                 d -= TAU;
             } else if d < -PI {
@@ -303,7 +334,10 @@ pub(super) fn describe_wall(
             intervals.push((start, end));
         }
     }
-    intervals.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.total_cmp(&y.1)));
+    // by start alone: the union below is the same whatever the order of equal starts (each
+    // extends the interval it starts in to the largest end), and −0 and +0 start alike (the
+    // starts are ≥ 0, so their bits order them as numbers)
+    let intervals = sorted_by_key(intervals, |x| if x.0 == 0.0 { 0 } else { x.0.to_bits() });
     // union of the intervals and the largest gap (cyclically)
     let mut merged: Vec<(f64, f64)> = Vec::new();
     for (s, e) in intervals {
@@ -339,6 +373,40 @@ pub(super) fn describe_wall(
         area,
         triangles: triangles.len(),
     }
+}
+
+/// `items` in the order of `key`, equal keys in their order (a least-significant-digit radix
+/// sort, 11 bits a pass, a pass skipped where every key has the same digit): linear in the
+/// number of items, where a comparison sort of a wall's 10⁵ arcs took most of its description.
+fn sorted_by_key<T: Copy>(items: Vec<T>, key: impl Fn(&T) -> u64) -> Vec<T> {
+    const BITS: u32 = 11;
+    let mask = (1u64 << BITS) - 1;
+    let mut keys: Vec<u64> = items.iter().map(&key).collect();
+    let (mut items, mut spare_items) = (items.clone(), items);
+    let mut spare_keys = keys.clone();
+    for shift in (0..64).step_by(BITS as usize) {
+        let digit = |k: u64| ((k >> shift) & mask) as usize;
+        let mut start = vec![0usize; 1 << BITS];
+        for &k in &keys {
+            start[digit(k)] += 1;
+        }
+        if start.contains(&keys.len()) {
+            continue;
+        }
+        let mut sum = 0;
+        for s in start.iter_mut() {
+            (*s, sum) = (sum, sum + *s);
+        }
+        for (&k, &item) in keys.iter().zip(&items) {
+            let slot = &mut start[digit(k)];
+            spare_keys[*slot] = k;
+            spare_items[*slot] = item;
+            *slot += 1;
+        }
+        std::mem::swap(&mut keys, &mut spare_keys);
+        std::mem::swap(&mut items, &mut spare_items);
+    }
+    items
 }
 
 /// Every bore of the surface (any arc), merged, largest wall area first.
@@ -464,4 +532,33 @@ pub fn find_bores(mesh: &IndexedMesh) -> Vec<Bore> {
         .collect();
     bores.sort_by(|a, b| b.area.total_cmp(&a.area));
     bores
+}
+
+#[cfg(test)]
+mod tests {
+    use super::sorted_by_key;
+
+    /// The radix sort gives the order of the standard library's stable sort: keys of every size
+    /// (f64 bits of angles in [0, 2π], small integers, repeats), equal keys in their order.
+    #[test]
+    fn the_radix_sort_is_a_stable_sort() {
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let angles: Vec<(u64, usize)> = (0..5000)
+            .map(|i| ((next() % 1000) as f64 * std::f64::consts::TAU / 1000.0, i))
+            .map(|(a, i)| (a.to_bits(), i))
+            .collect();
+        let small: Vec<(u64, usize)> = (0..5000).map(|i| (next() % 7, i)).collect();
+        let wide: Vec<(u64, usize)> = (0..5000).map(|i| (next(), i)).collect();
+        for items in [angles, small, wide, Vec::new()] {
+            let mut expected = items.clone();
+            expected.sort_by_key(|x| x.0);
+            assert_eq!(sorted_by_key(items, |x| x.0), expected);
+        }
+    }
 }

@@ -34,9 +34,7 @@ use crate::rod::{BoreSpec, RodOptions};
 use anyhow::{Context, Result};
 use std::path::{Path, PathBuf};
 
-/// The dihedral angle (degrees) of gmsh's first surface classification: edges sharper than this
-/// are features, not facet kinks of a curved surface.
-pub const FEATURE_ANGLE_DEG: f64 = 40.0;
+pub use crate::mesher::policy::FEATURE_ANGLE_DEG;
 
 /// How stage 3 meshes: one fixed mesh, adaptive refinement, or the user's mesh.
 #[derive(Debug, Clone, PartialEq)]
