@@ -42,6 +42,17 @@ fn allowed_params(keyword: &str) -> Option<&'static [&'static str]> {
         "EL PRINT" => &["ELSET", "TOTALS", "FREQUENCY", "GLOBAL"],
         "NODE FILE" | "EL FILE" => &["FREQUENCY", "OUTPUT", "GLOBAL"],
         "SECTION PRINT" => &["SURFACE", "NAME", "FREQUENCY"],
+        // ccx reads parameter names without their blanks
+        "COUPLING" => &[
+            "REF NODE",
+            "REFNODE",
+            "SURFACE",
+            "CONSTRAINT NAME",
+            "CONSTRAINTNAME",
+            "ORIENTATION",
+        ],
+        "KINEMATIC" => &[],
+        "DISTRIBUTING" => &["CYCLIC SYMMETRY", "CYCLICSYMMETRY"],
         _ => return None,
     })
 }
@@ -57,9 +68,8 @@ fn why_refused(keyword: &str) -> &'static str {
         | "CONTACT FILE"
         | "CONTACT PRINT"
         | "CONTACT OUTPUT" => "contact is not supported",
-        "COUPLING" | "KINEMATIC" | "DISTRIBUTING" | "RIGID BODY" => {
-            "couplings to a reference node are not supported: load the nodes directly \
-             (*CLOAD) or tie them with *EQUATION"
+        "RIGID BODY" | "DISTRIBUTING COUPLING" => {
+            "this coupling is not supported: use *COUPLING with *KINEMATIC or *DISTRIBUTING"
         }
         "PLASTIC" | "HYPERELASTIC" | "CREEP" | "DEFORMATION PLASTICITY" | "USER MATERIAL" => {
             "nonlinear materials are not supported (linear elastic only)"
@@ -105,6 +115,8 @@ pub(super) struct Reader {
     pub(super) first_request: [bool; 4],
     pub(super) node_file: Vec<String>,
     pub(super) el_file: Vec<String>,
+    /// A `*COUPLING` read, its `*KINEMATIC` or `*DISTRIBUTING` next.
+    pub(super) coupling: Option<super::coupling_cards::PendingCoupling>,
 }
 
 /// Keywords of a step only.
@@ -141,6 +153,9 @@ const MODEL_ONLY: &[&str] = &[
     "PHYSICAL CONSTANTS",
     "SOLID SECTION",
     "STEP",
+    "COUPLING",
+    "KINEMATIC",
+    "DISTRIBUTING",
 ];
 
 impl Model {
@@ -157,6 +172,14 @@ impl Model {
         if r.in_step {
             refusals.push(error(path, r.state.line, "*STEP without *END STEP"));
         }
+        if let Some(p) = r.coupling.take() {
+            refusals.push(error(
+                path,
+                p.line(),
+                "*COUPLING without its *KINEMATIC or *DISTRIBUTING card",
+            ));
+        }
+        refusals.extend(m.finish_couplings());
         if refusals.is_empty() {
             if m.elements.is_empty() {
                 refusals.push(error(
@@ -180,6 +203,15 @@ impl Model {
     fn read_card(&mut self, path: &Path, card: &Card, r: &mut Reader) -> Result<()> {
         let m = self;
         let kw = card.keyword.as_str();
+        if !matches!(kw, "KINEMATIC" | "DISTRIBUTING")
+            && let Some(p) = r.coupling.take()
+        {
+            return Err(error(
+                path,
+                p.line(),
+                "*COUPLING must be followed at once by *KINEMATIC or *DISTRIBUTING",
+            ));
+        }
         let Some(allowed) = allowed_params(kw) else {
             return Err(error(
                 path,
@@ -222,6 +254,7 @@ impl Model {
                 | "SURFACE"
                 | "TRANSFORM"
                 | "EQUATION"
+                | "KINEMATIC"
                 | "ELASTIC"
                 | "DENSITY"
                 | "BOUNDARY"
@@ -237,7 +270,7 @@ impl Model {
             return Err(error(path, card.line, format!("*{kw} without data lines")));
         }
         let max_data = match kw {
-            "MATERIAL" | "STEP" | "END STEP" | "OUTPUT" | "PHYSICAL CONSTANTS" => 0,
+            "MATERIAL" | "STEP" | "END STEP" | "OUTPUT" | "PHYSICAL CONSTANTS" | "COUPLING" => 0,
             // a solid section may carry one data line (a thickness, unused for solids)
             "SOLID SECTION" | "STATIC" | "BUCKLE" | "FREQUENCY" | "TRANSFORM" => 1,
             _ => usize::MAX,
@@ -257,6 +290,8 @@ impl Model {
             "SURFACE" => m.read_surface(path, card),
             "TRANSFORM" => m.read_transform(path, card),
             "EQUATION" => m.read_equation(path, card),
+            "COUPLING" => m.read_coupling(path, card, r),
+            "KINEMATIC" | "DISTRIBUTING" => m.read_coupling_kind(path, card, r),
             "MATERIAL" => {
                 let name = required(path, card, "NAME")?.to_ascii_uppercase();
                 if m.materials.contains_key(&name) {
