@@ -115,8 +115,9 @@ pub(super) struct Reader {
     pub(super) first_request: [bool; 4],
     pub(super) node_file: Vec<String>,
     pub(super) el_file: Vec<String>,
-    /// A `*COUPLING` read, its `*KINEMATIC` or `*DISTRIBUTING` next.
-    pub(super) coupling: Option<super::coupling_cards::PendingCoupling>,
+    /// A `*COUPLING` read, its `*KINEMATIC` or `*DISTRIBUTING` next: its reference node,
+    /// surface and line.
+    pub(super) coupling: Option<(usize, String, usize)>,
 }
 
 /// Keywords of a step only.
@@ -175,7 +176,7 @@ impl Model {
         if let Some(p) = r.coupling.take() {
             refusals.push(error(
                 path,
-                p.line(),
+                p.2,
                 "*COUPLING without its *KINEMATIC or *DISTRIBUTING card",
             ));
         }
@@ -208,7 +209,7 @@ impl Model {
         {
             return Err(error(
                 path,
-                p.line(),
+                p.2,
                 "*COUPLING must be followed at once by *KINEMATIC or *DISTRIBUTING",
             ));
         }

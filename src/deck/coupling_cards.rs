@@ -24,21 +24,6 @@ use super::parse::{Card, error, int, push_unique};
 use crate::fem::error::Result;
 use crate::fem::shape::TET10_FACES;
 
-/// A `*COUPLING` waiting for its `*KINEMATIC` or `*DISTRIBUTING`.
-#[derive(Clone, Debug)]
-pub(super) struct PendingCoupling {
-    reference: usize,
-    surface: String,
-    line: usize,
-}
-
-impl PendingCoupling {
-    /// Line of the `*COUPLING`.
-    pub(super) fn line(&self) -> usize {
-        self.line
-    }
-}
-
 /// The value of a parameter written with or without its blanks (`REF NODE` or `REFNODE`, as ccx
 /// reads both).
 fn param_any<'a>(card: &'a Card, name: &str) -> Option<&'a str> {
@@ -79,11 +64,7 @@ impl Model {
                 format!("surface {surface} is not defined (*SURFACE before *COUPLING)"),
             ));
         }
-        r.coupling = Some(PendingCoupling {
-            reference,
-            surface,
-            line: card.line,
-        });
+        r.coupling = Some((reference, surface, card.line));
         Ok(())
     }
 
@@ -95,7 +76,7 @@ impl Model {
         r: &mut Reader,
     ) -> Result<()> {
         let kw = card.keyword.as_str();
-        let Some(p) = r.coupling.take() else {
+        let Some((reference, surface, line)) = r.coupling.take() else {
             return Err(error(
                 path,
                 card.line,
@@ -130,7 +111,7 @@ impl Model {
         }
         let faces = self
             .element_surfaces
-            .get(&p.surface)
+            .get(&surface)
             .cloned()
             .unwrap_or_default();
         let mut nodes = Vec::new();
@@ -138,15 +119,15 @@ impl Model {
             if kw == "DISTRIBUTING" {
                 return Err(error(
                     path,
-                    p.line,
+                    line,
                     format!(
                         "*DISTRIBUTING needs an element-face surface (*SURFACE, TYPE=ELEMENT): \
                          {} is a node surface, which carries no areas to weigh the nodes",
-                        p.surface
+                        surface
                     ),
                 ));
             }
-            push_unique(&mut nodes, self.nsets[&p.surface].iter().copied());
+            push_unique(&mut nodes, self.nsets[&surface].iter().copied());
         } else {
             for &(e, f) in &faces {
                 let el = &self.elements[e];
@@ -157,10 +138,10 @@ impl Model {
                 );
             }
         }
-        if nodes.contains(&p.reference) {
+        if nodes.contains(&reference) {
             return Err(error(
                 path,
-                p.line,
+                line,
                 "the reference node lies on the coupling's own surface: give a node of its own",
             ));
         }
@@ -189,12 +170,12 @@ impl Model {
             }
         };
         self.couplings.push(Coupling {
-            reference: p.reference,
-            surface: p.surface,
+            reference,
+            surface,
             faces,
             nodes,
             kind,
-            line: p.line,
+            line,
             file: card.file.clone(),
         });
         Ok(())
