@@ -52,6 +52,24 @@ fn allowed_params(keyword: &str) -> Option<&'static [&'static str]> {
             "ORIENTATION",
         ],
         "KINEMATIC" => &[],
+        "SURFACE INTERACTION" => &["NAME"],
+        "SURFACE BEHAVIOR" => &["PRESSURE-OVERCLOSURE"],
+        "CONTACT PAIR" => &[
+            "INTERACTION",
+            "TYPE",
+            "SMALL SLIDING",
+            "SMALLSLIDING",
+            "ADJUST",
+        ],
+        "CONTACT FILE" => &[
+            "FREQUENCY",
+            "OUTPUT",
+            "GLOBAL",
+            "TOTALS",
+            "LAST ITERATIONS",
+            "CONTACT ELEMENTS",
+        ],
+        "CONTACT PRINT" => &["FREQUENCY", "TOTALS", "TIME POINTS"],
         "DISTRIBUTING" => &["CYCLIC SYMMETRY", "CYCLICSYMMETRY"],
         _ => return None,
     })
@@ -60,14 +78,10 @@ fn allowed_params(keyword: &str) -> Option<&'static [&'static str]> {
 /// What ccx does that rodstudy does not, for the message of a refused keyword.
 fn why_refused(keyword: &str) -> &'static str {
     match keyword {
-        "CONTACT PAIR"
-        | "SURFACE INTERACTION"
-        | "SURFACE BEHAVIOR"
-        | "FRICTION"
-        | "TIE"
-        | "CONTACT FILE"
-        | "CONTACT PRINT"
-        | "CONTACT OUTPUT" => "contact is not supported",
+        "FRICTION" => "friction is not supported: frictionless contact only (remove *FRICTION)",
+        "TIE" | "CONTACT OUTPUT" | "GAP" | "CLEARANCE" => {
+            "only *CONTACT PAIR, TYPE=SURFACE TO SURFACE contact is supported"
+        }
         "RIGID BODY" | "DISTRIBUTING COUPLING" => {
             "this coupling is not supported: use *COUPLING with *KINEMATIC or *DISTRIBUTING"
         }
@@ -118,6 +132,8 @@ pub(super) struct Reader {
     /// A `*COUPLING` read, its `*KINEMATIC` or `*DISTRIBUTING` next: its reference node,
     /// surface and line.
     pub(super) coupling: Option<(usize, String, usize)>,
+    /// The `*SURFACE INTERACTION` being read.
+    pub(super) interaction: Option<String>,
 }
 
 /// Keywords of a step only.
@@ -135,6 +151,8 @@ const STEP_ONLY: &[&str] = &[
     "EL FILE",
     "SECTION PRINT",
     "OUTPUT",
+    "CONTACT FILE",
+    "CONTACT PRINT",
     "END STEP",
 ];
 
@@ -157,6 +175,9 @@ const MODEL_ONLY: &[&str] = &[
     "COUPLING",
     "KINEMATIC",
     "DISTRIBUTING",
+    "SURFACE INTERACTION",
+    "SURFACE BEHAVIOR",
+    "CONTACT PAIR",
 ];
 
 impl Model {
@@ -241,6 +262,9 @@ impl Model {
                 format!("*{kw} inside a step (missing *END STEP?)"),
             ));
         }
+        if kw != "SURFACE BEHAVIOR" {
+            r.interaction = None;
+        }
         if !matches!(kw, "ELASTIC" | "DENSITY" | "EXPANSION") {
             if kw != "MATERIAL" {
                 r.material = None;
@@ -256,6 +280,7 @@ impl Model {
                 | "TRANSFORM"
                 | "EQUATION"
                 | "KINEMATIC"
+                | "CONTACT PAIR"
                 | "ELASTIC"
                 | "DENSITY"
                 | "BOUNDARY"
@@ -293,6 +318,18 @@ impl Model {
             "EQUATION" => m.read_equation(path, card),
             "COUPLING" => m.read_coupling(path, card, r),
             "KINEMATIC" | "DISTRIBUTING" => m.read_coupling_kind(path, card, r),
+            "SURFACE INTERACTION" => m.read_surface_interaction(path, card, &mut r.interaction),
+            "SURFACE BEHAVIOR" => m.read_surface_behavior(path, card, &r.interaction),
+            "CONTACT PAIR" => m.read_contact_pair(path, card),
+            "CONTACT FILE" | "CONTACT PRINT" => {
+                m.warnings.push(format!(
+                    "{}:{}: *{kw} skipped: the contact pressures are in the JSON's `contact` \
+                     block of the step",
+                    path.display(),
+                    card.line
+                ));
+                Ok(())
+            }
             "MATERIAL" => {
                 let name = required(path, card, "NAME")?.to_ascii_uppercase();
                 if m.materials.contains_key(&name) {

@@ -196,6 +196,34 @@ pub struct Coupling {
     pub file: std::path::PathBuf,
 }
 
+/// The pressure–overclosure law of a `*SURFACE BEHAVIOR`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ContactLaw {
+    /// HARD: no penetration, no tension (solved exactly; ccx's penalty slope K, if given, is
+    /// only reported).
+    Hard,
+    /// LINEAR: p = K · overclosure, no tension.
+    Linear {
+        /// K (pressure per length).
+        k: f64,
+    },
+}
+
+/// A `*CONTACT PAIR` (TYPE=SURFACE TO SURFACE, frictionless, small sliding).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactPair {
+    /// Its `*SURFACE INTERACTION` (upper case).
+    pub interaction: String,
+    /// The slave (dependent) element-face surface.
+    pub slave: String,
+    /// The master (independent) element-face surface.
+    pub master: String,
+    /// Line of the data line.
+    pub line: usize,
+    /// File of the card.
+    pub file: std::path::PathBuf,
+}
+
 /// A step's state: supports, loads (accumulated over the earlier steps) and output requests.
 #[derive(Clone, Debug, Default)]
 pub struct Step {
@@ -247,6 +275,11 @@ pub struct Model {
     pub transforms: BTreeMap<usize, Transform>,
     /// Equations (`*EQUATION`): terms (node, dof 0–2, coefficient) and the line.
     pub equations: Vec<Equation>,
+    /// Surface interactions by (upper-cased) name: their law (`None` before `*SURFACE
+    /// BEHAVIOR`) and line.
+    pub interactions: BTreeMap<String, (Option<ContactLaw>, usize)>,
+    /// Contact pairs.
+    pub contact_pairs: Vec<ContactPair>,
     /// Couplings to reference nodes (`*COUPLING` with `*KINEMATIC` or `*DISTRIBUTING`).
     pub couplings: Vec<Coupling>,
     /// Warnings: what is read but changes nothing, or is skipped (with its line).
