@@ -141,8 +141,8 @@ fn compare_u(ours: &serde_json::Value, ccx: &Ccx) -> f64 {
     let scale = max_abs(ccx.u.values().flatten());
     let mut d = 0.0f64;
     for (id, ui) in ids.iter().zip(&u) {
-        for j in 0..3 {
-            d = d.max((ui[j] - ccx.u[id][j]).abs() / scale);
+        for (a, b) in ui.iter().zip(&ccx.u[id]) {
+            d = d.max((a - b).abs() / scale);
         }
     }
     d

@@ -93,7 +93,7 @@ impl Model {
                         "PRESSURE-OVERCLOSURE=LINEAR needs its slope: a line 'K[, σ∞, c0]'",
                     )
                 })?;
-                if !(k > 0.0) {
+                if k.is_nan() || k <= 0.0 {
                     return Err(error(
                         path,
                         card.data[0].line,

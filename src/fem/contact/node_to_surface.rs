@@ -145,6 +145,10 @@ static PIECES: std::sync::LazyLock<Vec<[[f64; 3]; 3]>> = std::sync::LazyLock::ne
     pieces
 });
 
+/// A point paired with the master surface: its gap, the master face's nodes, their shape values
+/// at the closest point, the normal there.
+type Paired = (f64, [usize; 6], [f64; 6], [f64; 3]);
+
 /// The master surface point nearest to `p`: (gap g0 = n·(p − x_p), the master face's nodes and
 /// shape values at x_p, n), or `None` when it is farther than `reach` or beside the surface's
 /// rim (the offset not along the normal).
@@ -154,8 +158,10 @@ fn pair(
     boxes: &[([f64; 3], [f64; 3])],
     p: [f64; 3],
     reach: f64,
-) -> Option<(f64, [usize; 6], [f64; 6], [f64; 3])> {
-    let mut best: Option<(f64, usize, [f64; 2], [f64; 3], [f64; 3])> = None;
+) -> Option<Paired> {
+    // (distance, face, (s, t), closest point, normal)
+    type Nearest = (f64, usize, [f64; 2], [f64; 3], [f64; 3]);
+    let mut best: Option<Nearest> = None;
     for (k, m) in master.iter().enumerate() {
         let (lo, hi) = boxes[k];
         let out: f64 = (0..3)
@@ -254,9 +260,9 @@ pub fn contact_rows(
                     };
                     rows[row].g0 += wb * g0;
                     for a in 0..6 {
-                        for j in 0..3 {
-                            *terms[row].entry(3 * face[a] + j).or_default() += wb * ns[a] * n[j];
-                            *terms[row].entry(3 * mnodes[a] + j).or_default() -= wb * nm[a] * n[j];
+                        for (j, nj) in n.iter().enumerate() {
+                            *terms[row].entry(3 * face[a] + j).or_default() += wb * ns[a] * nj;
+                            *terms[row].entry(3 * mnodes[a] + j).or_default() -= wb * nm[a] * nj;
                         }
                     }
                 }
