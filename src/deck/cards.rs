@@ -42,6 +42,35 @@ fn allowed_params(keyword: &str) -> Option<&'static [&'static str]> {
         "EL PRINT" => &["ELSET", "TOTALS", "FREQUENCY", "GLOBAL"],
         "NODE FILE" | "EL FILE" => &["FREQUENCY", "OUTPUT", "GLOBAL"],
         "SECTION PRINT" => &["SURFACE", "NAME", "FREQUENCY"],
+        // ccx reads parameter names without their blanks
+        "COUPLING" => &[
+            "REF NODE",
+            "REFNODE",
+            "SURFACE",
+            "CONSTRAINT NAME",
+            "CONSTRAINTNAME",
+            "ORIENTATION",
+        ],
+        "KINEMATIC" => &[],
+        "SURFACE INTERACTION" => &["NAME"],
+        "SURFACE BEHAVIOR" => &["PRESSURE-OVERCLOSURE"],
+        "CONTACT PAIR" => &[
+            "INTERACTION",
+            "TYPE",
+            "SMALL SLIDING",
+            "SMALLSLIDING",
+            "ADJUST",
+        ],
+        "CONTACT FILE" => &[
+            "FREQUENCY",
+            "OUTPUT",
+            "GLOBAL",
+            "TOTALS",
+            "LAST ITERATIONS",
+            "CONTACT ELEMENTS",
+        ],
+        "CONTACT PRINT" => &["FREQUENCY", "TOTALS", "TIME POINTS"],
+        "DISTRIBUTING" => &["CYCLIC SYMMETRY", "CYCLICSYMMETRY"],
         _ => return None,
     })
 }
@@ -49,17 +78,12 @@ fn allowed_params(keyword: &str) -> Option<&'static [&'static str]> {
 /// What ccx does that rodstudy does not, for the message of a refused keyword.
 fn why_refused(keyword: &str) -> &'static str {
     match keyword {
-        "CONTACT PAIR"
-        | "SURFACE INTERACTION"
-        | "SURFACE BEHAVIOR"
-        | "FRICTION"
-        | "TIE"
-        | "CONTACT FILE"
-        | "CONTACT PRINT"
-        | "CONTACT OUTPUT" => "contact is not supported",
-        "COUPLING" | "KINEMATIC" | "DISTRIBUTING" | "RIGID BODY" => {
-            "couplings to a reference node are not supported: load the nodes directly \
-             (*CLOAD) or tie them with *EQUATION"
+        "FRICTION" => "friction is not supported: frictionless contact only (remove *FRICTION)",
+        "TIE" | "CONTACT OUTPUT" | "GAP" | "CLEARANCE" => {
+            "only *CONTACT PAIR, TYPE=SURFACE TO SURFACE contact is supported"
+        }
+        "RIGID BODY" | "DISTRIBUTING COUPLING" => {
+            "this coupling is not supported: use *COUPLING with *KINEMATIC or *DISTRIBUTING"
         }
         "PLASTIC" | "HYPERELASTIC" | "CREEP" | "DEFORMATION PLASTICITY" | "USER MATERIAL" => {
             "nonlinear materials are not supported (linear elastic only)"
@@ -105,6 +129,11 @@ pub(super) struct Reader {
     pub(super) first_request: [bool; 4],
     pub(super) node_file: Vec<String>,
     pub(super) el_file: Vec<String>,
+    /// A `*COUPLING` read, its `*KINEMATIC` or `*DISTRIBUTING` next: its reference node,
+    /// surface and line.
+    pub(super) coupling: Option<(usize, String, usize)>,
+    /// The `*SURFACE INTERACTION` being read.
+    pub(super) interaction: Option<String>,
 }
 
 /// Keywords of a step only.
@@ -122,6 +151,8 @@ const STEP_ONLY: &[&str] = &[
     "EL FILE",
     "SECTION PRINT",
     "OUTPUT",
+    "CONTACT FILE",
+    "CONTACT PRINT",
     "END STEP",
 ];
 
@@ -141,6 +172,12 @@ const MODEL_ONLY: &[&str] = &[
     "PHYSICAL CONSTANTS",
     "SOLID SECTION",
     "STEP",
+    "COUPLING",
+    "KINEMATIC",
+    "DISTRIBUTING",
+    "SURFACE INTERACTION",
+    "SURFACE BEHAVIOR",
+    "CONTACT PAIR",
 ];
 
 impl Model {
@@ -157,6 +194,14 @@ impl Model {
         if r.in_step {
             refusals.push(error(path, r.state.line, "*STEP without *END STEP"));
         }
+        if let Some(p) = r.coupling.take() {
+            refusals.push(error(
+                path,
+                p.2,
+                "*COUPLING without its *KINEMATIC or *DISTRIBUTING card",
+            ));
+        }
+        refusals.extend(m.finish_couplings());
         if refusals.is_empty() {
             if m.elements.is_empty() {
                 refusals.push(error(
@@ -180,6 +225,15 @@ impl Model {
     fn read_card(&mut self, path: &Path, card: &Card, r: &mut Reader) -> Result<()> {
         let m = self;
         let kw = card.keyword.as_str();
+        if !matches!(kw, "KINEMATIC" | "DISTRIBUTING")
+            && let Some(p) = r.coupling.take()
+        {
+            return Err(error(
+                path,
+                p.2,
+                "*COUPLING must be followed at once by *KINEMATIC or *DISTRIBUTING",
+            ));
+        }
         let Some(allowed) = allowed_params(kw) else {
             return Err(error(
                 path,
@@ -208,6 +262,9 @@ impl Model {
                 format!("*{kw} inside a step (missing *END STEP?)"),
             ));
         }
+        if kw != "SURFACE BEHAVIOR" {
+            r.interaction = None;
+        }
         if !matches!(kw, "ELASTIC" | "DENSITY" | "EXPANSION") {
             if kw != "MATERIAL" {
                 r.material = None;
@@ -222,6 +279,8 @@ impl Model {
                 | "SURFACE"
                 | "TRANSFORM"
                 | "EQUATION"
+                | "KINEMATIC"
+                | "CONTACT PAIR"
                 | "ELASTIC"
                 | "DENSITY"
                 | "BOUNDARY"
@@ -237,7 +296,7 @@ impl Model {
             return Err(error(path, card.line, format!("*{kw} without data lines")));
         }
         let max_data = match kw {
-            "MATERIAL" | "STEP" | "END STEP" | "OUTPUT" | "PHYSICAL CONSTANTS" => 0,
+            "MATERIAL" | "STEP" | "END STEP" | "OUTPUT" | "PHYSICAL CONSTANTS" | "COUPLING" => 0,
             // a solid section may carry one data line (a thickness, unused for solids)
             "SOLID SECTION" | "STATIC" | "BUCKLE" | "FREQUENCY" | "TRANSFORM" => 1,
             _ => usize::MAX,
@@ -257,6 +316,20 @@ impl Model {
             "SURFACE" => m.read_surface(path, card),
             "TRANSFORM" => m.read_transform(path, card),
             "EQUATION" => m.read_equation(path, card),
+            "COUPLING" => m.read_coupling(path, card, r),
+            "KINEMATIC" | "DISTRIBUTING" => m.read_coupling_kind(path, card, r),
+            "SURFACE INTERACTION" => m.read_surface_interaction(path, card, &mut r.interaction),
+            "SURFACE BEHAVIOR" => m.read_surface_behavior(path, card, &r.interaction),
+            "CONTACT PAIR" => m.read_contact_pair(path, card),
+            "CONTACT FILE" | "CONTACT PRINT" => {
+                m.warnings.push(format!(
+                    "{}:{}: *{kw} skipped: the contact pressures are in the JSON's `contact` \
+                     block of the step",
+                    path.display(),
+                    card.line
+                ));
+                Ok(())
+            }
             "MATERIAL" => {
                 let name = required(path, card, "NAME")?.to_ascii_uppercase();
                 if m.materials.contains_key(&name) {

@@ -67,12 +67,43 @@ impl Model {
                     "a *BOUNDARY line is 'node|nset, first, last, value'",
                 ));
             }
-            if !(1..=3).contains(&first) || !(first..=3).contains(&last) {
+            if !(1..=6).contains(&first) || !(first..=6).contains(&last) {
                 return Err(error(
                     path,
                     d.line,
-                    format!("dofs {first}..{last}: only displacements 1-3 exist on solid elements"),
+                    format!(
+                        "dofs {first}..{last}: only displacements 1-3 exist on solid elements \
+                         (rotations 4-6 on a *KINEMATIC coupling's reference node)"
+                    ),
                 ));
+            }
+            for &n in &nodes {
+                match self.coupling_of(n).map(|c| &c.kind) {
+                    Some(CouplingKind::Distributing { .. }) => {
+                        return Err(error(
+                            path,
+                            d.line,
+                            format!(
+                                "node {} is a *DISTRIBUTING coupling's reference node, which \
+                                 only passes its loads on: support the model's own nodes",
+                                self.node_ids[n]
+                            ),
+                        ));
+                    }
+                    Some(CouplingKind::Kinematic { .. }) => {}
+                    None if last > 3 => {
+                        return Err(error(
+                            path,
+                            d.line,
+                            format!(
+                                "dofs {first}..{last} on node {}: rotations 4-6 exist only on \
+                                 the reference node of a *COUPLING with *KINEMATIC above",
+                                self.node_ids[n]
+                            ),
+                        ));
+                    }
+                    None => {}
+                }
             }
             for &n in &nodes {
                 for dof in first..=last {
@@ -96,12 +127,35 @@ impl Model {
                 .get(1)
                 .ok_or_else(|| error(path, d.line, "missing dof"))?;
             let dof = int(path, d.line, f1, "dof")?;
-            if !(1..=3).contains(&dof) {
+            if !(1..=6).contains(&dof) {
                 return Err(error(
                     path,
                     d.line,
-                    format!("dof {dof}: only forces 1-3 exist on solid elements"),
+                    format!(
+                        "dof {dof}: forces are 1-3 (moments 4-6 on a coupling's reference node)"
+                    ),
                 ));
+            }
+            if dof > 3 {
+                for &n in &nodes {
+                    let ok = match self.coupling_of(n).map(|c| &c.kind) {
+                        Some(CouplingKind::Kinematic { .. }) => true,
+                        Some(CouplingKind::Distributing { moments }) => moments[(dof - 4) as usize],
+                        None => false,
+                    };
+                    if !ok {
+                        return Err(error(
+                            path,
+                            d.line,
+                            format!(
+                                "a moment (dof {dof}) on node {}: moments act only on the \
+                                 reference node of a *COUPLING with *KINEMATIC, or with \
+                                 *DISTRIBUTING listing dof {dof}",
+                                self.node_ids[n]
+                            ),
+                        ));
+                    }
+                }
             }
             let v = load(path, d, 2, "load")?;
             if d.fields.len() > 3 {

@@ -20,6 +20,10 @@
 
 pub mod cards;
 pub mod constraint_cards;
+pub mod contact;
+pub mod contact_cards;
+pub mod coupling;
+pub mod coupling_cards;
 pub mod fields;
 pub mod load_cards;
 pub mod mesh_cards;

@@ -157,16 +157,84 @@ pub enum Totals {
 /// An equation: terms (node, dof 0–2, coefficient) and the line of its first data line.
 pub type Equation = (Vec<(usize, usize, f64)>, usize);
 
+/// What a `*COUPLING` does with its reference node.
+#[derive(Clone, Debug, PartialEq)]
+pub enum CouplingKind {
+    /// `*KINEMATIC`: the listed displacement DOFs (0–2) of every surface node follow the
+    /// reference node rigidly, u_i = u_R + θ × (x_i − x_R) (linearised rigid-body motion).
+    Kinematic {
+        /// DOFs constrained (0–2).
+        dofs: [bool; 3],
+        /// The node whose three DOFs are the reference node's rotations θ (added after the
+        /// deck's nodes, as ccx adds its rotational node).
+        rotation_node: usize,
+    },
+    /// `*DISTRIBUTING`: the reference node's force (and the listed moments) applied to the
+    /// surface's nodes as point loads with area weights (ccx's distributing coupling).
+    Distributing {
+        /// Moments about x, y, z distributed (DOFs 4–6 listed).
+        moments: [bool; 3],
+    },
+}
+
+/// A `*COUPLING` with its `*KINEMATIC` or `*DISTRIBUTING` card.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Coupling {
+    /// The reference node.
+    pub reference: usize,
+    /// The surface's name (upper case).
+    pub surface: String,
+    /// Its element faces (element, face 0–3), empty for a node surface.
+    pub faces: Vec<(usize, usize)>,
+    /// Its nodes (first occurrence order, no repeats).
+    pub nodes: Vec<usize>,
+    /// Kinematic or distributing.
+    pub kind: CouplingKind,
+    /// Line of `*COUPLING`.
+    pub line: usize,
+    /// File of `*COUPLING`.
+    pub file: std::path::PathBuf,
+}
+
+/// The pressure–overclosure law of a `*SURFACE BEHAVIOR`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ContactLaw {
+    /// HARD: no penetration, no tension (solved exactly; ccx's penalty slope K, if given, is
+    /// only reported).
+    Hard,
+    /// LINEAR: p = K · overclosure, no tension.
+    Linear {
+        /// K (pressure per length).
+        k: f64,
+    },
+}
+
+/// A `*CONTACT PAIR` (TYPE=SURFACE TO SURFACE, frictionless, small sliding).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactPair {
+    /// Its `*SURFACE INTERACTION` (upper case).
+    pub interaction: String,
+    /// The slave (dependent) element-face surface.
+    pub slave: String,
+    /// The master (independent) element-face surface.
+    pub master: String,
+    /// Line of the data line.
+    pub line: usize,
+    /// File of the card.
+    pub file: std::path::PathBuf,
+}
+
 /// A step's state: supports, loads (accumulated over the earlier steps) and output requests.
 #[derive(Clone, Debug, Default)]
 pub struct Step {
     /// Line of `*STEP`.
     pub line: usize,
-    /// Prescribed displacements (node, dof 0–2) → value.
+    /// Prescribed displacements (node, dof 0–2; 3–5: rotations of a kinematic coupling's
+    /// reference node) → value.
     pub boundary: BTreeMap<(usize, usize), f64>,
     /// Supported node sets (for the reaction totals): name → nodes; single nodes as `NODE <id>`.
     pub supported_sets: BTreeMap<String, Vec<usize>>,
-    /// Concentrated loads (node, dof 0–2) → value.
+    /// Concentrated loads (node, dof 0–2; 3–5: moments on a coupling's reference node) → value.
     pub cloads: BTreeMap<(usize, usize), f64>,
     /// Pressures (element, face 0–3) → p.
     pub pressures: BTreeMap<(usize, usize), f64>,
@@ -207,6 +275,13 @@ pub struct Model {
     pub transforms: BTreeMap<usize, Transform>,
     /// Equations (`*EQUATION`): terms (node, dof 0–2, coefficient) and the line.
     pub equations: Vec<Equation>,
+    /// Surface interactions by (upper-cased) name: their law (`None` before `*SURFACE
+    /// BEHAVIOR`) and line.
+    pub interactions: BTreeMap<String, (Option<ContactLaw>, usize)>,
+    /// Contact pairs.
+    pub contact_pairs: Vec<ContactPair>,
+    /// Couplings to reference nodes (`*COUPLING` with `*KINEMATIC` or `*DISTRIBUTING`).
+    pub couplings: Vec<Coupling>,
     /// Warnings: what is read but changes nothing, or is skipped (with its line).
     pub warnings: Vec<String>,
     /// The steps.
@@ -219,5 +294,10 @@ impl Model {
     /// Index of node `id`.
     pub fn node(&self, id: i64) -> Option<usize> {
         self.node_index.get(&id).copied()
+    }
+
+    /// The coupling whose reference node is `n`, if any.
+    pub fn coupling_of(&self, n: usize) -> Option<&Coupling> {
+        self.couplings.iter().find(|c| c.reference == n)
     }
 }

@@ -20,6 +20,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
+use super::contact::{ContactOut, contact_forces};
 use super::fields::field;
 use super::model::{Analysis, Model, Step, Totals};
 use super::system::{DeckSystem, deck_system, merged_requests, step_loads, step_reduction};
@@ -106,6 +107,9 @@ pub struct StepResult {
     pub node_sets: BTreeMap<String, NodeSetOut>,
     /// Requested element sets (`*EL PRINT`).
     pub element_sets: BTreeMap<String, ElementSetOut>,
+    /// The contact of the step's `*CONTACT PAIR`s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact: Option<ContactOut>,
     /// Σ RF (= K u) per supported node set (single nodes as `NODE <id>`).
     pub reaction_totals: BTreeMap<String, [f64; 3]>,
     /// Σ of the applied nodal loads.
@@ -283,6 +287,29 @@ fn solve_step(
     }
     let mut q = b.clone();
     factor.solve_in_place(&mut q, 1);
+    let mut contact = None;
+    if !model.contact_pairs.is_empty() {
+        if !matches!(analysis, Analysis::Static) {
+            return Err(at(
+                "*CONTACT PAIR in a *BUCKLE or *FREQUENCY step is not supported (contact is \
+                 solved in *STATIC steps)"
+                    .into(),
+            ));
+        }
+        let u0 = reduction.expand(&q);
+        let (fc, out) =
+            contact_forces(model, reduction, factor, &u0).map_err(|e| at(e.to_string()))?;
+        for (fi, c) in f.iter_mut().zip(&fc) {
+            *fi += c;
+        }
+        b = reduction.restrict(&f);
+        for (bi, di) in b.iter_mut().zip(dirichlet) {
+            *bi += di;
+        }
+        q = b.clone();
+        factor.solve_in_place(&mut q, 1);
+        contact = Some(out);
+    }
     let kq = k.mul(&q);
     let rnorm = kq
         .iter()
@@ -472,6 +499,7 @@ fn solve_step(
             Analysis::Frequency { .. } => "frequency",
         },
         eigen,
+        contact,
         node_sets,
         element_sets,
         reaction_totals,

@@ -16,7 +16,8 @@
 use std::collections::{BTreeMap, HashSet};
 use std::path::Path;
 
-use super::model::{Model, Step, Transform};
+use super::coupling::{distribute, kinematic_constraints};
+use super::model::{CouplingKind, Model, Step, Transform};
 use crate::fem::boundary::face_point;
 use crate::fem::constraints::{Constraint, Reduction};
 use crate::fem::error::{FemError, Result};
@@ -204,7 +205,6 @@ pub fn step_reduction(
     step: &Step,
 ) -> Result<Reduction> {
     let mut constraints = Vec::new();
-    let mut in_equation = HashSet::new();
     for (terms, line) in &model.equations {
         // a DOF of a node with local axes is the local one (manual, "*EQUATION")
         let mut global = Vec::new();
@@ -223,9 +223,11 @@ pub fn step_reduction(
             value: 0.0,
             label: format!("{}: *EQUATION of line {line}", path.display()),
         });
-        in_equation.extend(terms.iter().map(|t| t.0));
     }
+    constraints.extend(kinematic_constraints(path, model));
+    let linked = linked_dofs(&constraints);
     for (&(n, j), &v) in &step.boundary {
+        let (n, j) = rotation_dof(model, n, j);
         let mut terms: Vec<(usize, f64)> = match node_axes(path, model, n)? {
             None => vec![(3 * n + j, 1.0)],
             Some(axes) => (0..3)
@@ -245,18 +247,49 @@ pub fn step_reduction(
             ),
         });
     }
+    let supported: HashSet<usize> = step
+        .boundary
+        .keys()
+        .map(|&(n, j)| {
+            let (n, j) = rotation_dof(model, n, j);
+            3 * n + j
+        })
+        .collect();
     for n in 0..model.nodes.len() {
-        if !sys.used[n] && !in_equation.contains(&n) {
-            for j in 0..3 {
-                constraints.push(Constraint {
-                    terms: vec![(3 * n + j, 1.0)],
-                    value: 0.0,
-                    label: "a node of no element".into(),
-                });
-            }
+        if sys.used[n] {
+            continue;
+        }
+        for d in (3 * n..3 * n + 3).filter(|d| !linked.contains(d) && !supported.contains(d)) {
+            constraints.push(Constraint {
+                terms: vec![(d, 1.0)],
+                value: 0.0,
+                label: "a DOF of no element and no equation".into(),
+            });
         }
     }
     Reduction::new(3 * model.nodes.len(), &constraints)
+}
+
+/// The DOFs that `constraints` (equations, couplings) tie to others: those of a node of no
+/// element stay free (the rest of such a node is held at zero).
+fn linked_dofs(constraints: &[Constraint]) -> HashSet<usize> {
+    constraints
+        .iter()
+        .filter(|c| c.terms.len() > 1)
+        .flat_map(|c| c.terms.iter().map(|t| t.0))
+        .collect()
+}
+
+/// Node and DOF (0–2) of DOF `j` (0–5) of node `n`: a rotation (3–5) of a kinematic coupling's
+/// reference node is a DOF of its rotation node.
+fn rotation_dof(model: &Model, n: usize, j: usize) -> (usize, usize) {
+    if j < 3 {
+        return (n, j);
+    }
+    match model.coupling_of(n).map(|c| &c.kind) {
+        Some(CouplingKind::Kinematic { rotation_node, .. }) => (*rotation_node, j - 3),
+        _ => unreachable!("the deck reader admits rotations on kinematic reference nodes only"),
+    }
 }
 
 /// The load vector of `step` (3 per deck node, global axes).
@@ -268,8 +301,26 @@ pub fn step_loads(
     number: usize,
 ) -> Result<Vec<f64>> {
     let mut f = vec![0.0; 3 * model.nodes.len()];
+    let mut carried: BTreeMap<usize, [f64; 6]> = BTreeMap::new();
+    let kinematic = kinematic_constraints(path, model);
+    let linked = linked_dofs(&kinematic);
+    let tied = |n: usize| {
+        sys.used[n]
+            || (0..3).any(|j| linked.contains(&(3 * n + j)))
+            || model
+                .equations
+                .iter()
+                .any(|(t, _)| t.len() > 1 && t.iter().any(|x| x.0 == n))
+    };
     for (&(n, j), &v) in &step.cloads {
-        if !sys.used[n] {
+        if let Some(c) = model.coupling_of(n)
+            && matches!(c.kind, CouplingKind::Distributing { .. })
+        {
+            carried.entry(n).or_default()[j] += v;
+            continue;
+        }
+        let (n, j) = rotation_dof(model, n, j);
+        if !tied(n) {
             return Err(FemError::InvalidInput(format!(
                 "step {number}: *CLOAD on node {}, which no element uses",
                 model.node_ids[n]
@@ -283,6 +334,10 @@ pub fn step_loads(
                 }
             }
         }
+    }
+    for (n, v) in carried {
+        let c = model.coupling_of(n).expect("a reference node");
+        distribute(model, c, [v[0], v[1], v[2]], [v[3], v[4], v[5]], &mut f)?;
     }
     for (&(e, face), &p) in &step.pressures {
         let el = &model.elements[e];

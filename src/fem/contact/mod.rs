@@ -22,6 +22,7 @@ pub mod cylinder;
 pub mod lcp;
 pub mod measures;
 pub mod modes;
+pub mod node_to_surface;
 pub mod problem;
 pub mod solve;
 pub mod weights;
