@@ -34,8 +34,10 @@
 //! not the cosine about θ itself: that is the interpolation's only error, O(Δ²), measured in the
 //! tests against direct solves (see [`tests`]).
 
+pub mod local_fatigue;
 mod unit_cases;
 
+pub use local_fatigue::{LocalFatigueSolution, local_fatigue};
 pub use unit_cases::*;
 
 use rayon::prelude::*;
