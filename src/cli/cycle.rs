@@ -73,7 +73,9 @@ pub fn run(args: CycleArgs) -> Result<i32> {
     let mesh = f.mesh;
     let c = stages::cycle::cycle(&mass, &mesh, &config)?;
     let mut cycle = c.record;
-    write_cycle_fields(&mut cycle, &mesh.mesh, &c.cycle, &c.units, &args.out)?;
+    write_cycle_fields(
+        &mut cycle, &mesh.mesh, &c.cycle, &c.units, &c.local, &args.out,
+    )?;
     // the static two-case analysis of the final mesh (assembly, factorisation, solves, stresses,
     // recovery and estimate), for the cost ratio
     let t = &fem.fem.timings;

@@ -32,7 +32,7 @@
 //! yield_mpa = 355.0
 //! safety_factor = 1.5
 //! with_error = false  # judge the peak plus its estimated error instead of the peak
-//! fatigue = true      # the criterion includes the cycle's fatigue safety factor …
+//! fatigue = true      # the criterion includes the cycle's local (FKM) fatigue factor …
 //! fatigue_safety_factor = 1.5   # … which must be at least this
 //! buckling_factor = 3.0         # the smallest accepted linear buckling load factor, judged
 //!                               # when buckling is computed (in the study: with a pressure trace)
@@ -221,7 +221,7 @@ pub struct CriterionConfig {
     pub with_error: bool,
     /// Include the cycle stage's fatigue safety factor in the criterion (when the stage runs).
     pub fatigue: bool,
-    /// The smallest accepted Goodman safety factor.
+    /// The smallest accepted local (FKM) fatigue safety factor.
     pub fatigue_safety_factor: f64,
     /// The smallest accepted linear buckling load factor λ₁ (buckling load / peak compression),
     /// judged where buckling is computed (the study: with `[engine] pressure_trace`). Written

@@ -300,8 +300,7 @@ pub fn longest_chord(plane: &[[f64; 3]]) -> (usize, usize) {
     };
     let (a, _) = farthest(0);
     let (_, estimate) = farthest(a);
-    let c: [f64; 3] =
-        std::array::from_fn(|k| u.iter().map(|p| p[k]).sum::<f64>() / n as f64);
+    let c: [f64; 3] = std::array::from_fn(|k| u.iter().map(|p| p[k]).sum::<f64>() / n as f64);
     let radius: Vec<f64> = u.iter().map(|p| dist(p, &c)).collect();
     let r_max = radius.iter().copied().fold(0.0, f64::max);
     // a margin for round-off: a skipped i is strictly short of the longest chord

@@ -299,10 +299,11 @@ fn walk(mesh: &TetMesh, neighbours: &[[u32; 4]], start: usize, x: [f64; 3]) -> W
         };
         let xi = inv * r;
         let l = [1.0 - xi[0] - xi[1] - xi[2], xi[0], xi[1], xi[2]];
-        let (i, lmin) = l
-            .iter()
-            .enumerate()
-            .fold((0, f64::INFINITY), |b, (i, &v)| if v < b.1 { (i, v) } else { b });
+        let (i, lmin) =
+            l.iter().enumerate().fold(
+                (0, f64::INFINITY),
+                |b, (i, &v)| if v < b.1 { (i, v) } else { b },
+            );
         if lmin >= -1e-9 {
             return match natural_coords(mesh, e, x) {
                 Some(xi) => Walk::Found(e, xi),
@@ -398,7 +399,10 @@ fn natural_coords(mesh: &TetMesh, e: usize, x: [f64; 3]) -> Option<[f64; 3]> {
         let r = Vector3::new(x[0] - c[0][0], x[1] - c[0][1], x[2] - c[0][2]);
         let xi = jac.try_inverse()? * r;
         let l = [1.0 - xi[0] - xi[1] - xi[2], xi[0], xi[1], xi[2]];
-        return l.iter().all(|&v| v >= -1e-9).then_some([xi[0], xi[1], xi[2]]);
+        return l
+            .iter()
+            .all(|&v| v >= -1e-9)
+            .then_some([xi[0], xi[1], xi[2]]);
     }
     let mut xi = [0.25; 3];
     for _ in 0..25 {

@@ -5,6 +5,7 @@
 pub mod atomic_write;
 pub mod columns;
 pub mod design_files;
+pub mod fatigue_pictures;
 pub mod fields;
 pub mod index_page;
 pub mod mass_properties;

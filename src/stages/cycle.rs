@@ -16,12 +16,12 @@ use super::records::{
     StageMesh,
 };
 use crate::config::StudyConfig;
+use crate::fatigue::{ComponentAssessment, LocalSettings};
 use crate::fem::QuadratureChoice;
 use crate::fem::body_force::mesh_mass_properties;
 use crate::fem::material::Material;
-use crate::mechanism::rod_frame_engine_cycle;
-use crate::fatigue::{ComponentAssessment, LocalSettings};
 use crate::mechanism::RodFrameInstant;
+use crate::mechanism::rod_frame_engine_cycle;
 use crate::rod::cycle::{
     CycleOptions, CycleSolution, DEFAULT_DIRECTION_STEP_DEG, LocalFatigueSolution, PinBasis,
     UnitSolutions, combine, local_fatigue, rod_inertia_of, unit_solutions_for,
@@ -251,7 +251,10 @@ fn local_record(
             factor_at_local_node: at(c.node),
             factor_at_goodman_node: at(goodman_node),
             same_node: worst.node == c.node,
-            distance_from_local_mm: ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt(),
+            distance_from_local_mm: ((p[0] - q[0]).powi(2)
+                + (p[1] - q[1]).powi(2)
+                + (p[2] - q[2]).powi(2))
+            .sqrt(),
         },
         map_picture: None,
         haigh_picture: None,

@@ -33,8 +33,8 @@ use rayon::prelude::*;
 use super::{Terms, UnitSolutions};
 use crate::fatigue::tensor::axpy;
 use crate::fatigue::{
-    FindleyResult, FindleySettings, GradientOptions, LocalAssessment,
-    LocalSettings, NodeHistory, assess_node, depth_gradients, findley, surface_points,
+    FindleyResult, FindleySettings, GradientOptions, LocalAssessment, LocalSettings, NodeHistory,
+    assess_node, depth_gradients, findley, surface_points,
 };
 use crate::fem::error::{FemError, Result};
 use crate::fem::mesh::TetMesh;
