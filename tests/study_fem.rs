@@ -85,7 +85,8 @@ fn study_runs_stage_3_and_ranks_by_the_criterion_first() {
                 assert!((r - fb).abs() < 1e-6 * peak, "{id}: {h}");
             }
         }
-        let n = cycle["fatigue_safety_factor"].as_f64().unwrap();
+        // the criterion judges the local (FKM) fatigue factor
+        let n = cycle["local_fatigue_safety_factor"].as_f64().unwrap();
         assert_eq!(c["fatigue_safety_factor"].as_f64(), Some(n));
         assert_eq!(
             c["pass"].as_bool().unwrap(),

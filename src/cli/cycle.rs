@@ -73,7 +73,9 @@ pub fn run(args: CycleArgs) -> Result<i32> {
     let mesh = f.mesh;
     let c = stages::cycle::cycle(&mass, &mesh, &config)?;
     let mut cycle = c.record;
-    write_cycle_fields(&mut cycle, &mesh.mesh, &c.cycle, &c.units, &args.out)?;
+    write_cycle_fields(
+        &mut cycle, &mesh.mesh, &c.cycle, &c.units, &c.local, &args.out,
+    )?;
     // the static two-case analysis of the final mesh (assembly, factorisation, solves, stresses,
     // recovery and estimate), for the cost ratio
     let t = &fem.fem.timings;
@@ -122,6 +124,28 @@ pub fn run(args: CycleArgs) -> Result<i32> {
             cycle.fatigue_alternating_mpa,
             cycle.fatigue_mean_mpa
         );
+        if let Some(l) = &cycle.local_fatigue {
+            outln!(
+                "local fatigue (FKM, jD {:.2}): safety factor {:.2} at ({:.1}, {:.1}, {:.1}) mm, χ* {:.3}/mm, n {:.3}, σa {:.2} MPa, σm {:.2} MPa, σWK {:.1} MPa; Findley {:.2} at ({:.1}, {:.1}, {:.1}) mm ({} nodes; {:.2} at the FKM node); {:.2} s",
+                l.j_d,
+                l.safety_factor,
+                l.at_mm[0],
+                l.at_mm[1],
+                l.at_mm[2],
+                l.chi_star_per_mm,
+                l.support_factor,
+                l.sigma1.amplitude_mpa,
+                l.sigma1.mean_mpa,
+                l.sigma1.sigma_wk_mpa,
+                l.findley.factor,
+                l.findley.at_mm[0],
+                l.findley.at_mm[1],
+                l.findley.at_mm[2],
+                l.findley.nodes_checked,
+                l.findley.factor_at_local_node,
+                l.seconds
+            );
+        }
         outln!(
             "reaction at B against the dynamics' F_B: largest difference {:.2e} of the peak pin force ({:.1} N); mesh mass {:.4} kg (STL {:.4} kg)",
             cycle.reaction_mismatch_rel,

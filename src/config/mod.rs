@@ -38,7 +38,7 @@
 //! yield_mpa = 355.0
 //! safety_factor = 1.5
 //! with_error = false  # judge the peak plus its estimated error instead of the peak
-//! fatigue = true      # the criterion includes the cycle's fatigue safety factor …
+//! fatigue = true      # the criterion includes the cycle's local (FKM) fatigue factor …
 //! fatigue_safety_factor = 1.5   # … which must be at least this
 //! buckling_factor = 3.0         # the smallest accepted linear buckling load factor, judged
 //!                               # when buckling is computed (in the study: with a pressure trace)
@@ -47,10 +47,19 @@
 //! enabled = true      # trace over the four-stroke cycle (720°, the gas force on the piston)
 //! instants = 360      # per revolution, equally spaced, the first at crank angle 0
 //!
-//! [material]          # fatigue strengths (S355: EN 10025-2 minimum tensile strength; Shigley's
-//! ultimate_mpa = 470.0          # S'e = 0.5 Sut for steels, no Marin factors)
-//! endurance_mpa = 235.0
-//! mean_stress = "goodman"       # or "gerber": the mean-stress correction of the fatigue factor
+//! [material]          # fatigue strengths (S355, EN 10025-2; material.rs gives the sources)
+//! ultimate_mpa = 470.0          # R_m (S_ut)
+//! yield_mpa = 355.0             # R_p
+//! material_group = "steel"      # FKM material group (its constants)
+//! # fatigue_limit_mpa = 211.5   # a tested σ_W,zd; absent: FKM's f_W,σ · R_m
+//! surface_roughness_um = 200.0  # R_z: forged skin (machined 100, ground 12.5, polished 0)
+//! surface_treatment = "none"    # or "shot_peened", "cold_rolled", "nitrided", …
+//! overload = "constant_ratio"   # FKM F2 (or "constant_mean", F1)
+//! j_s = 1.0                     # FKM safety factors: loads,
+//! j_f = 1.5                     # fatigue strength,
+//! j_g = 1.0                     # castings
+//! endurance_mpa = 235.0         # the Goodman factor's S_e (Shigley's S'e = 0.5 Sut)
+//! mean_stress = "goodman"       # or "gerber": the Goodman factor's mean-stress correction
 //!
 //! [engine]            # the mechanism around the rod (defaults: the thesis' test rig)
 //! crank_radius_mm = 46.0
@@ -64,10 +73,11 @@
 //! ```
 
 mod engine;
+mod material;
 
 pub use engine::{EngineConfig, TracePath};
+pub use material::MaterialConfig;
 
-use crate::rod::fatigue::MeanStress;
 use crate::rod::pin_load::BoreLoad;
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
@@ -237,7 +247,7 @@ pub struct CriterionConfig {
     pub with_error: bool,
     /// Include the cycle stage's fatigue safety factor in the criterion (when the stage runs).
     pub fatigue: bool,
-    /// The smallest accepted Goodman safety factor.
+    /// The smallest accepted local (FKM) fatigue safety factor.
     pub fatigue_safety_factor: f64,
     /// The smallest accepted linear buckling load factor λ₁ (buckling load / peak compression),
     /// judged where buckling is computed (the study: with `[engine] pressure_trace`). Written
@@ -283,33 +293,6 @@ impl Default for CycleConfig {
         CycleConfig {
             enabled: true,
             instants: 360,
-        }
-    }
-}
-
-/// Fatigue strengths of the rod's material.
-///
-/// Defaults: S355 structural steel, minimum tensile strength 470 MPa (EN 10025-2, 3–100 mm);
-/// endurance limit of the polished rotating-beam specimen S'e = 0.5 Sut (Budynas–Nisbett,
-/// *Shigley's Mechanical Engineering Design*, 10th ed., eq. 6-8), without Marin factors (surface,
-/// size, reliability: set `endurance_mpa` to the corrected value for a real part).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct MaterialConfig {
-    pub ultimate_mpa: f64,
-    pub endurance_mpa: f64,
-    /// The mean-stress correction of the fatigue factor: `"goodman"` (default) or `"gerber"`
-    /// ([`crate::rod::fatigue::MeanStress`]); the default is not written into `results.json`.
-    #[serde(skip_serializing_if = "MeanStress::is_goodman")]
-    pub mean_stress: MeanStress,
-}
-
-impl Default for MaterialConfig {
-    fn default() -> Self {
-        MaterialConfig {
-            ultimate_mpa: 470.0,
-            endurance_mpa: 235.0,
-            mean_stress: MeanStress::Goodman,
         }
     }
 }
@@ -433,8 +416,6 @@ impl StudyConfig {
                 self.criterion.fatigue_safety_factor,
             ),
             ("criterion.buckling_factor", self.criterion.buckling_factor),
-            ("material.ultimate_mpa", self.material.ultimate_mpa),
-            ("material.endurance_mpa", self.material.endurance_mpa),
         ];
         for (key, v) in positive {
             if !(v.is_finite() && v > 0.0) {
@@ -489,12 +470,6 @@ impl StudyConfig {
             (
                 "criterion.yield_mpa",
                 self.criterion.yield_mpa,
-                MAX_STRENGTH_MPA,
-                "MPa",
-            ),
-            (
-                "material.ultimate_mpa",
-                self.material.ultimate_mpa,
                 MAX_STRENGTH_MPA,
                 "MPa",
             ),
@@ -555,9 +530,7 @@ impl StudyConfig {
                 self.fem.max_iterations
             );
         }
-        if self.material.endurance_mpa >= self.material.ultimate_mpa {
-            bail!("`material.endurance_mpa` must be below `material.ultimate_mpa`");
-        }
+        self.material.check()?;
         let max_steps = crate::mechanism::scene::MAX_STEPS;
         if self.driven.steps == 0 || self.driven.steps > max_steps {
             bail!(

@@ -162,6 +162,7 @@ pub fn depth_gradients(
     options: &GradientOptions,
 ) -> Vec<Option<PointGradients>> {
     let elems_of = node_elements(mesh);
+    let neighbours = face_neighbours(mesh);
     let k = options.intervals.max(3);
     points
         .par_iter()
@@ -180,7 +181,15 @@ pub fn depth_gradients(
             for i in 1..=k {
                 let d = depth * i as f64 / k as f64;
                 let x = std::array::from_fn(|j| x0[j] - d * n[j]);
-                let Some((e, xi)) = locate(mesh, &elems_of, &mut rings, last, x) else {
+                // from the previous sample a walk that leaves the mesh has crossed the wall
+                // between the two: the point is outside, no ring search
+                let start = last.unwrap_or(rings[0][0]);
+                let found = match walk(mesh, &neighbours, start, x) {
+                    Walk::Found(e, xi) => Some((e, xi)),
+                    Walk::Left if last.is_some() => None,
+                    _ => locate(mesh, &elems_of, &mut rings, last, x),
+                };
+                let Some((e, xi)) = found else {
                     break;
                 };
                 last = Some(e);
@@ -248,6 +257,78 @@ fn mean_edge(mesh: &TetMesh, elems: &[usize]) -> f64 {
     sum / count as f64
 }
 
+/// Per element, the element across the face opposite each corner (`NO_NEIGHBOUR` on the boundary).
+fn face_neighbours(mesh: &TetMesh) -> Vec<[u32; 4]> {
+    let mut out = vec![[NO_NEIGHBOUR; 4]; mesh.n_elements()];
+    let mut open: std::collections::HashMap<[usize; 3], (u32, usize)> =
+        std::collections::HashMap::with_capacity(2 * mesh.n_elements());
+    for (e, el) in mesh.elements().iter().enumerate() {
+        for i in 0..4 {
+            let mut f = [el[(i + 1) % 4], el[(i + 2) % 4], el[(i + 3) % 4]];
+            f.sort_unstable();
+            match open.remove(&f) {
+                Some((o, j)) => {
+                    out[e][i] = o;
+                    out[o as usize][j] = e as u32;
+                }
+                None => {
+                    open.insert(f, (e as u32, i));
+                }
+            }
+        }
+    }
+    out
+}
+
+const NO_NEIGHBOUR: u32 = u32::MAX;
+
+/// The element containing `x` by a walk through face neighbours from `start` (towards the face of
+/// the most negative volume coordinate of the corner tetrahedron), and its natural coordinates.
+/// The walk may leave the mesh ([`Walk::Left`]) or not settle; from an element next to `x` (the
+/// previous sample's, a fraction of an element length away) leaving means `x` is outside, from
+/// farther away the ring search of [`locate`] decides (a walk can leave a non-convex body on its
+/// way to a point inside).
+fn walk(mesh: &TetMesh, neighbours: &[[u32; 4]], start: usize, x: [f64; 3]) -> Walk {
+    let mut e = start;
+    for _ in 0..64 {
+        let c = mesh.element_coords(e);
+        let jac = Matrix3::from_fn(|i, k| c[k + 1][i] - c[0][i]);
+        let r = Vector3::new(x[0] - c[0][0], x[1] - c[0][1], x[2] - c[0][2]);
+        let Some(inv) = jac.try_inverse() else {
+            return Walk::Unsettled;
+        };
+        let xi = inv * r;
+        let l = [1.0 - xi[0] - xi[1] - xi[2], xi[0], xi[1], xi[2]];
+        let (i, lmin) =
+            l.iter().enumerate().fold(
+                (0, f64::INFINITY),
+                |b, (i, &v)| if v < b.1 { (i, v) } else { b },
+            );
+        if lmin >= -1e-9 {
+            return match natural_coords(mesh, e, x) {
+                Some(xi) => Walk::Found(e, xi),
+                None => Walk::Unsettled,
+            };
+        }
+        let next = neighbours[e][i];
+        if next == NO_NEIGHBOUR {
+            return Walk::Left;
+        }
+        e = next as usize;
+    }
+    Walk::Unsettled
+}
+
+/// Where a [`walk`] ended.
+enum Walk {
+    /// In this element, at these natural coordinates.
+    Found(usize, [f64; 3]),
+    /// Through a boundary face.
+    Left,
+    /// Nowhere decided (a curved element, a degenerate one, too many steps).
+    Unsettled,
+}
+
 /// The element of the search rings (grown on demand, up to four) containing `x`, and its natural
 /// coordinates; `hint` first.
 fn locate(
@@ -306,6 +387,22 @@ fn natural_coords(mesh: &TetMesh, e: usize, x: [f64; 3]) -> Option<[f64; 3]> {
     let pad = 0.1 * (0..3).map(|j| hi[j] - lo[j]).fold(0.0, f64::max);
     if (0..3).any(|j| x[j] < lo[j] - pad || x[j] > hi[j] + pad) {
         return None;
+    }
+    // a straight element (midside nodes at the edge midpoints): the isoparametric map is the
+    // corner tetrahedron's affine map, inverted directly
+    let scale = pad * 10.0;
+    let straight = TET10_EDGES.iter().enumerate().all(|(m, [a, b])| {
+        (0..3).all(|j| (c[4 + m][j] - 0.5 * (c[*a][j] + c[*b][j])).abs() <= 1e-12 * scale)
+    });
+    if straight {
+        let jac = Matrix3::from_fn(|i, k| c[k + 1][i] - c[0][i]);
+        let r = Vector3::new(x[0] - c[0][0], x[1] - c[0][1], x[2] - c[0][2]);
+        let xi = jac.try_inverse()? * r;
+        let l = [1.0 - xi[0] - xi[1] - xi[2], xi[0], xi[1], xi[2]];
+        return l
+            .iter()
+            .all(|&v| v >= -1e-9)
+            .then_some([xi[0], xi[1], xi[2]]);
     }
     let mut xi = [0.25; 3];
     for _ in 0..25 {

@@ -316,15 +316,29 @@ pub const COLUMNS: &[Column] = &[
         },
     },
     Column {
-        key: "fatigue",
+        key: "fatigue_goodman",
         shown: Shown::Always,
         cells: Cells::Design {
             csv: &[("fatigue_safety_factor", |r| {
                 Value::Num(r.cycle.map(|c| c.fatigue_safety_factor))
             })],
-            table: Some(("fatigue safety factor", |r| {
+            table: Some(("Goodman fatigue factor", |r| {
                 r.cycle
                     .map_or_else(dash, |c| format!("{:.2}", c.fatigue_safety_factor))
+            })),
+        },
+    },
+    Column {
+        key: "fatigue",
+        shown: Shown::Always,
+        cells: Cells::Design {
+            csv: &[("local_fatigue_safety_factor", |r| {
+                Value::Num(r.cycle.and_then(|c| c.local_fatigue_safety_factor))
+            })],
+            table: Some(("fatigue safety factor (FKM local)", |r| {
+                r.cycle
+                    .and_then(|c| c.local_fatigue_safety_factor)
+                    .map_or_else(dash, |s| format!("{s:.2}"))
             })),
         },
     },
@@ -438,6 +452,7 @@ pub const TABLE: &[&str] = &[
     "load_model",
     "cycle_max",
     "fatigue",
+    "fatigue_goodman",
     "buckling",
     "peak_pin_force",
     "peak_compression",

@@ -1,7 +1,8 @@
 //! The field files of one design, written after its stages have computed them: the ParaView files
 //! of stage 3 (`<stem>_fx.vtu`, `_fy.vtu`: displacement, averaged and recovered von Mises, the
 //! stress tensor, the bore sets, the error indicator) and of the cycle (`cycle.vtu`: max von Mises
-//! over the revolution, the fatigue factor, the signed alternating and mean stresses), and the
+//! over the revolution, the Goodman and the local (FKM) fatigue factors, χ*, the signed
+//! alternating and mean stresses), and the
 //! stress pictures of both (`von_mises_fx.svg`, `_fy.svg`, `von_mises_cycle.svg`), and the
 //! buckling mode when it was computed (`buckling_mode.vtu`). The records get the paths written.
 
@@ -14,7 +15,7 @@ use crate::fem::estimate::ErrorEstimate;
 use crate::fem::stress::StressField;
 use crate::report::picture::{PictureOptions, render_tet10_field};
 use crate::rod::BoreSurface;
-use crate::rod::cycle::{CycleSolution, UnitSolutions};
+use crate::rod::cycle::{CycleSolution, LocalFatigueSolution, UnitSolutions};
 use crate::rod::records::{FemResult, LoadCaseResult};
 use crate::rod::solve::RodSolution;
 use crate::stages::records::DesignCycle;
@@ -312,8 +313,12 @@ fn write_cycle_vtu(
     mesh: &TetMesh,
     cycle: &CycleSolution,
     units: &UnitSolutions,
+    local: &LocalFatigueSolution,
     gerber: bool,
 ) -> anyhow::Result<()> {
+    // off the surface: the local factor as ∞ (1e6), χ* as 0
+    let local_factor: Vec<f64> = local.safety_factor.iter().map(|v| v.min(1e6)).collect();
+    let chi_per_mm: Vec<f64> = local.chi_star_per_m.iter().map(|v| v * 1e-3).collect();
     let mpa = |v: &[f64]| v.iter().map(|x| x * 1e-6).collect::<Vec<_>>();
     // ∞ (an unloaded node) is written as a large finite number: ParaView reads no "inf"
     let factor: Vec<f64> = cycle
@@ -343,6 +348,16 @@ fn write_cycle_vtu(
                 },
                 components: 1,
                 data: &factor,
+            },
+            VtuField {
+                name: "local_fatigue_safety_factor_fkm",
+                components: 1,
+                data: &local_factor,
+            },
+            VtuField {
+                name: "chi_star_per_mm",
+                components: 1,
+                data: &chi_per_mm,
             },
             VtuField {
                 name: "signed_von_mises_alternating_MPa",
@@ -395,21 +410,30 @@ fn write_cycle_picture(
     Ok(())
 }
 
-/// Writes `dir/cycle.vtu` and `dir/von_mises_cycle.svg` of the cycle stage and records their
-/// paths in `record`.
+/// Writes `dir/cycle.vtu`, `dir/von_mises_cycle.svg` and the local fatigue pictures
+/// ([`super::fatigue_pictures`]) of the cycle stage and records their paths in `record`.
 pub fn write_cycle_fields(
     record: &mut DesignCycle,
     mesh: &TetMesh,
     cycle: &CycleSolution,
     units: &UnitSolutions,
+    local: &LocalFatigueSolution,
     dir: &Path,
 ) -> anyhow::Result<()> {
     use anyhow::Context;
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let vtu = dir.join("cycle.vtu");
-    write_cycle_vtu(&vtu, mesh, cycle, units, !record.mean_stress.is_goodman())?;
+    write_cycle_vtu(
+        &vtu,
+        mesh,
+        cycle,
+        units,
+        local,
+        !record.mean_stress.is_goodman(),
+    )?;
     let picture = dir.join("von_mises_cycle.svg");
     write_cycle_picture(&picture, mesh, cycle, record)?;
+    super::fatigue_pictures::write_fatigue_pictures(record, mesh, local, dir)?;
     record.vtu = Some(vtu);
     record.picture = Some(picture);
     Ok(())

@@ -369,6 +369,30 @@ fn design_section(s: &mut String, r: &RankRow, out: &Path) {
             &format!("{dir}/cycle.svg"),
             "the judged max von Mises at each crank angle",
         );
+        if let Some(l) = r.cycle.and_then(|c| c.local_fatigue.as_ref()) {
+            image(
+                s,
+                out,
+                &format!("{dir}/local_fatigue.svg"),
+                &format!(
+                    "local fatigue (FKM): 1/S at every surface node; lowest S = {:.2} at ({:.1}, {:.1}, {:.1}) mm; Findley's critical plane: {:.2} at ({:.1}, {:.1}, {:.1}) mm",
+                    l.safety_factor,
+                    l.at_mm[0],
+                    l.at_mm[1],
+                    l.at_mm[2],
+                    l.findley.factor,
+                    l.findley.at_mm[0],
+                    l.findley.at_mm[1],
+                    l.findley.at_mm[2]
+                ),
+            );
+            image(
+                s,
+                out,
+                &format!("{dir}/haigh.svg"),
+                "the Haigh diagram at the critical node: the component's line, the cycle's points, the load line to the limit",
+            );
+        }
     }
     // only the files of the stages this study reports (an earlier study's stay for its cache)
     let (fem, cycle) = (r.fem.is_some(), r.cycle.is_some());

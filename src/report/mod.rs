@@ -6,6 +6,7 @@ pub mod atomic_write;
 pub mod columns;
 pub mod contact_files;
 pub mod design_files;
+pub mod fatigue_pictures;
 pub mod fields;
 pub mod index_page;
 pub mod mass_properties;

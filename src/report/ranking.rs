@@ -136,17 +136,21 @@ pub fn explanation(results: &StudyResults) -> String {
         },
         if c.fatigue && !results.stages_skipped.iter().any(|s| s == "cycle") {
             format!(
-                "; and a {} fatigue safety factor ≥ {} over {} with inertia relief, Se {} / Sut {} MPa",
-                if results.config.material.mean_stress.is_goodman() {
-                    "Goodman"
-                } else {
-                    "Gerber"
-                },
+                "; and a local fatigue safety factor (FKM guideline, local stresses: support, roughness, mean stress at every surface node; jD {}) ≥ {} over {} with inertia relief, Rm {} MPa; the {} factor against Se {} / Sut {} MPa is shown beside it",
+                results.config.material.j_s
+                    * results.config.material.j_f
+                    * results.config.material.j_g,
                 c.fatigue_safety_factor,
                 if results.config.engine.pressure_trace.is_some() {
                     "the four-stroke cycle (720°, with the gas force)"
                 } else {
                     "one revolution"
+                },
+                results.config.material.ultimate_mpa,
+                if results.config.material.mean_stress.is_goodman() {
+                    "Goodman"
+                } else {
+                    "Gerber"
                 },
                 results.config.material.endurance_mpa,
                 results.config.material.ultimate_mpa

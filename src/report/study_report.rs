@@ -234,7 +234,7 @@ fn write_report_files(results: &StudyResults, dest: &Path) -> Result<Vec<PathBuf
 
 /// The files stage 3 and the cycle write into a design's folder (`fields`, and the cycle's table
 /// and plot above).
-const STAGE_FILES: [&str; 9] = [
+const STAGE_FILES: [&str; 11] = [
     "fem_fx.vtu",
     "fem_fy.vtu",
     "von_mises_fx.svg",
@@ -244,6 +244,8 @@ const STAGE_FILES: [&str; 9] = [
     "von_mises_cycle.svg",
     "cycle.csv",
     "cycle.svg",
+    "local_fatigue.svg",
+    "haigh.svg",
 ];
 
 /// Removes what an earlier study left in a design's folder that now disagrees with

@@ -9,15 +9,21 @@ use crate::rod::FemResult;
 
 /// Adds the cycle's fatigue safety factor to the verdict when the configuration judges fatigue:
 /// the design passes when it passed so far (statically, and on buckling when judged) and its
-/// Goodman factor is at least `criterion.fatigue_safety_factor`.
+/// local (FKM) fatigue factor is at least `criterion.fatigue_safety_factor`. The local factor is
+/// the component's: the notch's support, the surface and the mean stress at every surface node;
+/// the Goodman factor, a von Mises cycle against one specimen endurance limit, is judged only
+/// where no local factor was formed (a record from before it existed).
 pub fn judge_fatigue(verdict: &mut StressVerdict, cycle: &DesignCycle, config: &StudyConfig) {
     if !config.criterion.fatigue {
         return;
     }
     let required = config.criterion.fatigue_safety_factor;
-    verdict.fatigue_safety_factor = Some(cycle.fatigue_safety_factor);
+    let judged = cycle
+        .local_fatigue_safety_factor
+        .unwrap_or(cycle.fatigue_safety_factor);
+    verdict.fatigue_safety_factor = Some(judged);
     verdict.fatigue_required = Some(required);
-    verdict.pass = verdict.pass && cycle.fatigue_safety_factor >= required;
+    verdict.pass = verdict.pass && judged >= required;
 }
 
 /// Adds the linear buckling load factor λ₁ to the verdict: the design passes when it passed so

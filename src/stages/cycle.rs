@@ -11,16 +11,20 @@
 //! F_B of the dynamics at every instant; the stage reports how far those properties are from the
 //! STL's exact ones.
 
-use super::records::{CosineBoreLoadCases, DesignCycle, DesignMass, StageMesh};
+use super::records::{
+    CosineBoreLoadCases, DesignCycle, DesignMass, FindleyCheck, LocalComponent, LocalFatigue,
+    StageMesh,
+};
 use crate::config::StudyConfig;
+use crate::fatigue::{ComponentAssessment, LocalSettings};
 use crate::fem::QuadratureChoice;
 use crate::fem::body_force::mesh_mass_properties;
 use crate::fem::material::Material;
 use crate::mechanism::{RodFrameInstant, rod_frame_engine_cycle};
 use crate::rod::cycle::contact_instants::contact_at_instants_that_matter;
 use crate::rod::cycle::{
-    CycleOptions, CycleSolution, DEFAULT_DIRECTION_STEP_DEG, PinBasis, UnitSolutions, combine,
-    rod_inertia_of, unit_solutions_for,
+    CycleOptions, CycleSolution, DEFAULT_DIRECTION_STEP_DEG, LocalFatigueSolution, PinBasis,
+    UnitSolutions, combine, local_fatigue, rod_inertia_of, unit_solutions_for,
 };
 use crate::rod::fatigue::MeanStress;
 use anyhow::{Context, Result};
@@ -53,6 +57,8 @@ pub struct CycleOutcome {
     pub record: DesignCycle,
     pub units: UnitSolutions,
     pub cycle: CycleSolution,
+    /// The local (FKM) fatigue per surface node.
+    pub local: LocalFatigueSolution,
 }
 
 /// The cycle's settings for `mass` on stage 3's `mesh`.
@@ -116,6 +122,22 @@ pub fn cycle(mass: &DesignMass, mesh: &StageMesh, config: &StudyConfig) -> Resul
     } else {
         Vec::new()
     };
+    let local_start = Instant::now();
+    let terms = instants
+        .iter()
+        .map(|i| units.terms(i))
+        .collect::<crate::fem::error::Result<Vec<_>>>()
+        .with_context(context)?;
+    let local_settings = config.material.local_settings();
+    let local = local_fatigue(
+        &mesh.mesh,
+        &units,
+        &terms,
+        cycle.fatigue_node,
+        &local_settings,
+    )
+    .with_context(context)?;
+    let local_seconds = local_start.elapsed().as_secs_f64();
     let analysis_seconds = start.elapsed().as_secs_f64();
     let nodes = mesh.mesh.nodes();
     let mm = |n: usize| nodes[n].map(|v| v * 1e3);
@@ -158,6 +180,15 @@ pub fn cycle(mass: &DesignMass, mesh: &StageMesh, config: &StudyConfig) -> Resul
         },
         mean_stress: config.material.mean_stress,
         contact_instants,
+        local_fatigue_safety_factor: Some(local.critical().assessment.safety_factor),
+        local_fatigue: Some(local_record(
+            &local,
+            &mesh.mesh,
+            &instants,
+            f,
+            &local_settings,
+            local_seconds,
+        )),
         vtu: None,
         picture: None,
         analysis_seconds,
@@ -168,5 +199,95 @@ pub fn cycle(mass: &DesignMass, mesh: &StageMesh, config: &StudyConfig) -> Resul
         record,
         units,
         cycle,
+        local,
     })
+}
+
+/// How the local factor is formed (the record's `method`).
+pub const LOCAL_FATIGUE_METHOD: &str = "FKM guideline (6th ed. 2012), local stresses, at every surface node over the cycle: surface stress components σ1, σ2 (amplitude axes of the longest chord of the in-plane path); σW,zd = fW,σ Rm; χ* from the normal derivative of the recovered stress under the surface (cubic fit over two element lengths), support factor n(χ*), roughness KR (Rz), treatment KV, design factor KWK with K̃f = 2; mean-stress sensitivity Mσ on the Haigh diagram, overload case as configured; aBK = |σa| jD / σAK, von Mises combination; S = jD / aBK, the smallest over the judged surface nodes";
+
+fn component(c: &ComponentAssessment, treatment_factor: f64) -> LocalComponent {
+    let s = &c.strength;
+    LocalComponent {
+        direction: c.direction,
+        amplitude_mpa: c.amplitude_pa * 1e-6,
+        mean_mpa: c.mean_pa * 1e-6,
+        chi_star_per_mm: s.chi_star_sigma_per_m * 1e-3,
+        support_factor: s.n_sigma,
+        roughness_factor: s.k_r_sigma,
+        treatment_factor,
+        design_factor: s.k_wk_sigma,
+        sigma_w_zd_mpa: s.sigma_w_zd_pa * 1e-6,
+        sigma_wk_mpa: s.sigma_wk_pa * 1e-6,
+        mean_stress_sensitivity: c.mean_stress_sensitivity,
+        mean_stress_factor: c.k_ak,
+        sigma_ak_mpa: c.sigma_ak_pa * 1e-6,
+        utilisation: c.utilisation,
+    }
+}
+
+/// The record of the local assessment `local` on `mesh` over `instants`; `goodman_node` is the
+/// node of the smallest Goodman factor.
+fn local_record(
+    local: &LocalFatigueSolution,
+    mesh: &crate::fem::TetMesh,
+    instants: &[RodFrameInstant],
+    goodman_node: usize,
+    settings: &LocalSettings,
+    seconds: f64,
+) -> LocalFatigue {
+    let mm = |n: usize| mesh.nodes()[n].map(|v| v * 1e3);
+    let c = local.critical();
+    let a = &c.assessment;
+    let worst = local.findley_worst().expect("at least the critical node");
+    let at = |node: usize| {
+        local
+            .findley
+            .iter()
+            .find(|f| f.node == node)
+            .map_or(f64::NAN, |f| f.result.factor)
+    };
+    let (p, q) = (mm(worst.node), mm(c.node));
+    LocalFatigue {
+        method: LOCAL_FATIGUE_METHOD.into(),
+        node: c.node,
+        at_mm: q,
+        outward_normal: c.outward_normal,
+        safety_factor: a.safety_factor,
+        utilisation: a.utilisation,
+        j_d: a.j_d,
+        overload: settings.overload,
+        turning_points_deg: a.turning_points.map(|i| instants[i].crank_angle_deg),
+        chi_star_per_mm: a.sigma1.strength.chi_star_sigma_per_m * 1e-3,
+        support_factor: a.sigma1.strength.n_sigma,
+        gradient_found: c.has_gradient,
+        sigma1: component(&a.sigma1, settings.surface.treatment_factor),
+        sigma2: component(&a.sigma2, settings.surface.treatment_factor),
+        surface_nodes: local.surface.len(),
+        surface_nodes_without_gradient: local.surface.iter().filter(|s| !s.has_gradient).count(),
+        at_goodman_node: local.safety_factor[goodman_node]
+            .is_finite()
+            .then_some(local.safety_factor[goodman_node]),
+        findley: FindleyCheck {
+            nodes_checked: local.findley.len(),
+            k: worst.settings.k,
+            node: worst.node,
+            at_mm: p,
+            factor: worst.result.factor,
+            plane_normal: worst.result.normal,
+            shear_amplitude_mpa: worst.result.shear_amplitude_pa * 1e-6,
+            max_normal_stress_mpa: worst.result.max_normal_stress_pa * 1e-6,
+            local_factor_there: worst.local_factor,
+            factor_at_local_node: at(c.node),
+            factor_at_goodman_node: at(goodman_node),
+            same_node: worst.node == c.node,
+            distance_from_local_mm: ((p[0] - q[0]).powi(2)
+                + (p[1] - q[1]).powi(2)
+                + (p[2] - q[2]).powi(2))
+            .sqrt(),
+        },
+        map_picture: None,
+        haigh_picture: None,
+        seconds,
+    }
 }

@@ -151,7 +151,9 @@ pub struct StressVerdict {
     /// The static verdict alone (`pass` also includes fatigue when it is judged).
     #[serde(default)]
     pub static_pass: bool,
-    /// The cycle's Goodman safety factor and the smallest accepted, when fatigue is judged.
+    /// The fatigue factor the criterion judges and the smallest accepted, when fatigue is judged:
+    /// the cycle's local (FKM) factor, or its Goodman factor where no local one was formed
+    /// ([`crate::stages::criterion::judge_fatigue`]).
     #[serde(default)]
     pub fatigue_safety_factor: Option<f64>,
     #[serde(default)]
@@ -195,7 +197,9 @@ pub struct DesignCycle {
     pub crank_angle_of_max_deg: f64,
     /// Rod frame, mm (A at the origin, x towards B, z the pin axis).
     pub location_of_max_mm: [f64; 3],
-    /// Smallest Goodman safety factor over the judged nodes.
+    /// Smallest Goodman (or Gerber) safety factor over the judged nodes: the textbook factor of
+    /// the signed von Mises cycle against S_e and S_ut, kept as an interface beside
+    /// `local_fatigue_safety_factor` (the ranking's fatigue factor).
     pub fatigue_safety_factor: f64,
     pub fatigue_location_mm: [f64; 3],
     /// Alternating and mean signed von Mises at that node, MPa.
@@ -236,7 +240,14 @@ pub struct DesignCycle {
     /// The mean-stress correction of the fatigue factor (absent: Goodman).
     #[serde(default, skip_serializing_if = "MeanStress::is_goodman")]
     pub mean_stress: MeanStress,
-    /// ParaView file (max-over-cycle von Mises, fatigue factor) and the picture.
+    /// The local fatigue safety factor after the FKM guideline's local-stress procedure: the
+    /// smallest over the judged surface nodes (docs/fatigue.md); the ranking's fatigue factor.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub local_fatigue_safety_factor: Option<f64>,
+    /// Where it is and how it was formed: the factor chain, the Findley check.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub local_fatigue: Option<LocalFatigue>,
+    /// ParaView file (max-over-cycle von Mises, fatigue factors, χ*) and the picture.
     pub vtu: Option<PathBuf>,
     pub picture: Option<PathBuf>,
     /// Wall time of the analysis (six unit solves with one factorisation, the combination), s.
@@ -255,4 +266,97 @@ pub struct CosineBoreLoadCases {
     pub directions: usize,
     pub directions_solved: usize,
     pub unit_solves: usize,
+}
+
+/// The FKM local fatigue assessment of the cycle at its critical node ([`crate::rod::cycle::local_fatigue`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LocalFatigue {
+    /// How the factor is formed.
+    pub method: String,
+    /// The critical node (the judged surface node of the smallest factor) and where it is, rod
+    /// frame, mm.
+    pub node: usize,
+    pub at_mm: [f64; 3],
+    pub outward_normal: [f64; 3],
+    /// S = j_D / a_BK,sv: the load factor to the component fatigue limit.
+    pub safety_factor: f64,
+    /// Degree of utilisation a_BK,sv (≤ 1 passes FKM with j_D).
+    pub utilisation: f64,
+    /// j_D = j_S · j_F · j_G.
+    pub j_d: f64,
+    pub overload: crate::fatigue::OverloadCase,
+    /// Crank angles of the two instants taken as the cycle's turning points.
+    pub turning_points_deg: [f64; 2],
+    /// χ* of the larger surface component there, 1/mm, and its support factor n(χ*).
+    pub chi_star_per_mm: f64,
+    pub support_factor: f64,
+    /// Whether the stress gradient under the node could be formed (else n = 1).
+    pub gradient_found: bool,
+    /// The two surface stress components and their factor chains.
+    pub sigma1: LocalComponent,
+    pub sigma2: LocalComponent,
+    /// Surface nodes assessed, and those without a gradient (n = 1 there).
+    pub surface_nodes: usize,
+    pub surface_nodes_without_gradient: usize,
+    /// The local factor at the node of the smallest Goodman factor (absent off the surface).
+    pub at_goodman_node: Option<f64>,
+    /// The Findley critical-plane check.
+    pub findley: FindleyCheck,
+    /// The picture of the factor on the surface and the Haigh diagram at the critical node.
+    pub map_picture: Option<PathBuf>,
+    pub haigh_picture: Option<PathBuf>,
+    /// Wall time of the local assessment (gradients, every surface node, Findley), s.
+    pub seconds: f64,
+}
+
+/// One surface stress component at the critical node: the FKM chain, MPa and 1/mm.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LocalComponent {
+    /// Unit direction in the surface.
+    pub direction: [f64; 3],
+    /// Amplitude (signed relative to σ_1's) and mean, MPa.
+    pub amplitude_mpa: f64,
+    pub mean_mpa: f64,
+    /// Related stress gradient χ*, 1/mm.
+    pub chi_star_per_mm: f64,
+    /// Support factor n, roughness factor K_R, surface-treatment factor K_V, design factor K_WK.
+    pub support_factor: f64,
+    pub roughness_factor: f64,
+    pub treatment_factor: f64,
+    pub design_factor: f64,
+    /// σ_W,zd of the material and σ_WK of the component there, MPa.
+    pub sigma_w_zd_mpa: f64,
+    pub sigma_wk_mpa: f64,
+    /// Mean-stress sensitivity M_σ, mean-stress factor K_AK, amplitude strength σ_AK (MPa).
+    pub mean_stress_sensitivity: f64,
+    pub mean_stress_factor: f64,
+    pub sigma_ak_mpa: f64,
+    /// Degree of utilisation |σ_a| j_D / σ_AK.
+    pub utilisation: f64,
+}
+
+/// The Findley check at the nodes of the lowest local factors and the Goodman node.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FindleyCheck {
+    /// Nodes checked.
+    pub nodes_checked: usize,
+    /// The normal-stress sensitivity k (from f_W,τ).
+    pub k: f64,
+    /// The node of the smallest Findley factor among them, where, and the factor f_lim / f.
+    pub node: usize,
+    pub at_mm: [f64; 3],
+    pub factor: f64,
+    /// The critical plane's normal, shear amplitude and largest normal stress, MPa.
+    pub plane_normal: [f64; 3],
+    pub shear_amplitude_mpa: f64,
+    pub max_normal_stress_mpa: f64,
+    /// The local FKM factor at that node.
+    pub local_factor_there: Option<f64>,
+    /// The Findley factor at the FKM critical node.
+    pub factor_at_local_node: f64,
+    /// The Findley factor at the Goodman node.
+    pub factor_at_goodman_node: f64,
+    /// Whether Findley's critical node is the FKM one, and how far apart they are, mm.
+    pub same_node: bool,
+    pub distance_from_local_mm: f64,
 }

@@ -228,7 +228,13 @@ fn study_one(
                 "fem_fx.vtu",
                 "fem_fy.vtu",
             ]))
-            && (hit.cycle.is_none() || present(&["von_mises_cycle.svg", "cycle.vtu"]))
+            && (hit.cycle.is_none()
+                || present(&[
+                    "von_mises_cycle.svg",
+                    "cycle.vtu",
+                    "local_fatigue.svg",
+                    "haigh.svg",
+                ]))
     };
     if let (Some(cache), Some(key)) = (cache, &key)
         && let Some(hit) = cache.get::<CachedDesign>(&id, key)
@@ -304,8 +310,15 @@ fn study_one(
                 failed.stage = STAGES[3].into();
                 let c = stages::cycle::cycle(&mass, &f.mesh, config)?;
                 let mut c_record = c.record;
-                fields::write_cycle_fields(&mut c_record, &f.mesh.mesh, &c.cycle, &c.units, &dir)
-                    .with_context(|| format!("{}: cycle", mass.file))?;
+                fields::write_cycle_fields(
+                    &mut c_record,
+                    &f.mesh.mesh,
+                    &c.cycle,
+                    &c.units,
+                    &c.local,
+                    &dir,
+                )
+                .with_context(|| format!("{}: cycle", mass.file))?;
                 judge_fatigue(&mut record.criterion, &c_record, config);
                 cycle = Some(c_record);
             }

@@ -35,8 +35,10 @@
 //! tests against direct solves (see [`tests`]).
 
 pub mod contact_instants;
+pub mod local_fatigue;
 mod unit_cases;
 
+pub use local_fatigue::{LocalFatigueSolution, local_fatigue};
 pub use unit_cases::*;
 
 use rayon::prelude::*;
