@@ -12,12 +12,13 @@
 //! uniform and cosine load models like for like.
 
 use super::bores::{BoreSpec, BoreSurface, find_bores};
+use super::contact_cases::pin_in;
 use super::judged::{Bands, DEFAULT_FIXED_BAND_M, DEFAULT_SINGULAR_BAND_M, judged_nodes};
 use super::solve::RodOptions;
 use crate::fem::boundary::{boundary_faces, norm};
 use crate::fem::contact::{
-    ContactSolution, ContactTolerances, Cylinder, CylinderContact, DiameterChange, PinMotion,
-    Restraint, diameter_change, solve_contact,
+    ContactSolution, ContactTolerances, CylinderContact, DiameterChange, PinMotion, Restraint,
+    diameter_change, solve_contact,
 };
 use crate::fem::error::{FemError, Result};
 use crate::fem::material::Material;
@@ -87,27 +88,14 @@ pub fn solve_rod_contact(
     let axis = bores.unit_axis()?;
     let boundary = boundary_faces(mesh)?;
     let (loaded, fixed) = find_bores(mesh, &boundary, bores)?;
-    let pin = |bore: &BoreSurface, clearance: f64, motion: PinMotion| -> Result<Cylinder> {
-        let radius = bore.radius_m - clearance;
-        if !(clearance.is_finite() && radius > 0.0) {
-            return Err(FemError::InvalidInput(format!(
-                "contact load: clearance {clearance} m in a bore of radius {} m",
-                bore.radius_m
-            )));
-        }
-        Ok(Cylinder {
-            axis_point_m: bore.centre_m,
-            axis,
-            radius_m: radius,
-            faces: bore.faces.clone(),
-            // the gap from the bore's radius: a faceted wall's midside nodes lie inside it
-            nominal_bore_radius_m: Some(bore.radius_m),
-            motion,
-        })
-    };
     let cylinders = vec![
-        pin(&loaded, pins.clearance_a_m, PinMotion::Force(pins.force_n))?,
-        pin(&fixed, pins.clearance_b_m, PinMotion::Fixed)?,
+        pin_in(
+            &loaded,
+            axis,
+            pins.clearance_a_m,
+            PinMotion::Force(pins.force_n),
+        )?,
+        pin_in(&fixed, axis, pins.clearance_b_m, PinMotion::Fixed)?,
     ];
     let problem = crate::fem::contact::ContactProblem {
         mesh,
