@@ -109,18 +109,21 @@ pub fn cycle(mass: &DesignMass, mesh: &StageMesh, config: &StudyConfig) -> Resul
         .with_context(context)?;
     let span_deg = if gas.is_some() { 720.0 } else { 360.0 };
     let cycle = combine(&units, &instants, &options).with_context(context)?;
-    let contact_instants = if config.fem.load_model_error {
-        contact_at_instants_that_matter(
+    // the contact instants are figures beside the linear cycle: their failure is said, not fatal
+    let (contact_instants, contact_instants_error) = if config.fem.load_model_error {
+        match contact_at_instants_that_matter(
             &mesh.mesh,
             &material,
             &mesh.bores,
             &options,
             &instants,
             &cycle,
-        )
-        .with_context(context)?
+        ) {
+            Ok(v) => (v, None),
+            Err(e) => (Vec::new(), Some(format!("{e}"))),
+        }
     } else {
-        Vec::new()
+        (Vec::new(), None)
     };
     let local_start = Instant::now();
     let terms = instants
@@ -180,6 +183,7 @@ pub fn cycle(mass: &DesignMass, mesh: &StageMesh, config: &StudyConfig) -> Resul
         },
         mean_stress: config.material.mean_stress,
         contact_instants,
+        contact_instants_error,
         local_fatigue_safety_factor: Some(local.critical().assessment.safety_factor),
         local_fatigue: Some(local_record(
             &local,

@@ -237,6 +237,9 @@ pub struct DesignCycle {
     /// (`[fem] load_model_error = false`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub contact_instants: Vec<crate::rod::cycle::contact_instants::ContactInstant>,
+    /// Why the contact instants are missing where they were asked for and could not be solved.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact_instants_error: Option<String>,
     /// The mean-stress correction of the fatigue factor (absent: Goodman).
     #[serde(default, skip_serializing_if = "MeanStress::is_goodman")]
     pub mean_stress: MeanStress,
