@@ -1,11 +1,11 @@
 //! Frictionless contact of a tet10 body on rigid pins (`rodstudy::fem::contact`), each test
 //! against an independent reference: Lamé's thick cylinder (a pressed pin), the Fourier
 //! (Michell) series solution of a rigid pin with clearance in a large plate (a second method),
-//! and the equilibrium of a body held by two pins.
+//! the equilibrium of a body held by two pins, and a fresh solve for a factorised system reused.
 
 use rodstudy::fem::boundary::boundary_faces;
 use rodstudy::fem::contact::{
-    ContactProblem, ContactSolution, ContactTolerances, Cylinder, PinMotion, check,
+    ContactProblem, ContactSolution, ContactSystem, ContactTolerances, Cylinder, PinMotion, check,
     diameter_change, solve_contact,
 };
 use rodstudy::fem::mesh::ring::{Ring, ring_tet10};
@@ -454,6 +454,62 @@ fn a_body_held_by_two_pins_carries_the_pin_force_and_its_free_motions_carry_noth
         "{r:?}"
     );
     assert!((s.cylinders[0].resultant_n[1] - 5e3).abs() < 1e-10 * 5e3);
+}
+
+#[test]
+fn a_factorised_system_serves_other_pin_forces_as_a_fresh_solve_does() {
+    // pin A pushed along AB, then pulled back and pushed obliquely, on one factorisation: each
+    // solve equals solve_contact of the same problem; a column of S is computed once
+    let (mesh, fa, fb, plate) = two_eye();
+    let pa = pin(
+        fa,
+        plate.bore_a_radius - 20e-6,
+        PinMotion::Force([20e3, 0.0, 0.0]),
+    );
+    let mut pb = pin(fb, plate.bore_b_radius - 10e-6, PinMotion::Fixed);
+    pb.axis_point_m = [plate.length, 0.0, 0.0];
+    let mut p = problem(&mesh, vec![pa, pb]);
+    p.tolerances.free_mode_reaction_rel = None;
+    let system = ContactSystem::new(&p).unwrap();
+    let mut computed = Vec::new();
+    for force in [
+        [20e3, 0.0, 0.0],
+        [-15e3, 0.0, 0.0],
+        [20e3, 2e3, 0.0],
+        [20e3, 0.0, 0.0],
+    ] {
+        let mut q = p.clone();
+        q.cylinders[0].motion = PinMotion::Force(force);
+        let reused = system.solve(&q).unwrap();
+        let fresh = solve_contact(&q).unwrap();
+        recheck(&q, &reused);
+        let scale = fresh
+            .displacements
+            .iter()
+            .fold(0.0f64, |a, v| a.max(v.abs()));
+        let du = reused
+            .displacements
+            .iter()
+            .zip(&fresh.displacements)
+            .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+        assert!(du <= 1e-9 * scale, "{force:?}: {du:e} of {scale:e}");
+        for (a, b) in reused.cylinders.iter().zip(&fresh.cylinders) {
+            assert_eq!(a.arc_deg, b.arc_deg, "{force:?}");
+            assert!((a.peak_pressure_pa - b.peak_pressure_pa).abs() <= 1e-9 * b.peak_pressure_pa);
+        }
+        assert_eq!(reused.timings.factorisation_s, 0.0);
+        computed.push(reused.columns);
+    }
+    // the first push computes its columns; the same push again needs none
+    assert!(computed[0] > 0 && computed[3] == 0, "{computed:?}");
+    // another pin, another mesh or other supports are not the system's
+    let mut other = p.clone();
+    other.cylinders[1].radius_m -= 1e-6;
+    let err = system.solve(&other).unwrap_err().to_string();
+    assert!(err.contains("other pins"), "{err}");
+    let mut other = p.clone();
+    other.prescribed.push((2, 0.0));
+    assert!(system.solve(&other).is_err());
 }
 
 #[test]

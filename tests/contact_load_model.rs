@@ -4,6 +4,8 @@
 //! - the F_x case under contact equals the direct contact solve of the rod
 //!   (`solve_rod_contact`, pin B in contact) on the same mesh and clearances;
 //! - a half model (u_z = 0 on the plane, half the force, mirrored) equals the whole plate;
+//! - the cycle's contact instants on a half model (one factorisation for all instants) equal the
+//!   whole's;
 //! - a cycle instant without inertia equals the static F_x contact case of the same force;
 //! - every solve balances (the post-processing refuses a reaction that does not) and presses
 //!   without tension; the F_y case clamps bore B and leaves pin A's arc on the force's side.
@@ -22,6 +24,7 @@ use rodstudy::rod::fatigue::MeanStress;
 use rodstudy::rod::half_model::solve_rod_on;
 use rodstudy::rod::judged::{DEFAULT_FIXED_BAND_M, DEFAULT_SINGULAR_BAND_M};
 use rodstudy::rod::pin_load::BoreLoad;
+use rodstudy::rod::records::HalfModel;
 use rodstudy::rod::solve::solve_rod_fields;
 use rodstudy::rod::{BoreSpec, RodOptions};
 
@@ -131,6 +134,100 @@ fn a_half_model_under_contact_is_the_whole_plate() {
 }
 
 #[test]
+fn the_cycles_contact_instants_on_a_half_model_are_the_wholes() {
+    let t = 0.04;
+    let (p, h) = plate(t / 2.0, 2);
+    let nodes: Vec<[f64; 3]> = h
+        .nodes()
+        .iter()
+        .map(|x| [x[0], x[1], x[2] + t / 4.0])
+        .collect();
+    let half = TetMesh::new(nodes, h.elements().to_vec()).unwrap();
+    let m = mirror(&half, 0.0, 1e-9).unwrap();
+    let spec = contact_spec(&p);
+    // three instants with inertia along the rod, each in balance (the plate is symmetric about
+    // y = 0: the body force along x has no moment about B), so that the support of the rotation
+    // about pin B carries nothing, as in the study
+    let instants: Vec<RodFrameInstant> =
+        [(0.0, -12e3, -900.0), (180.0, 15e3, 600.0), (90.0, 5e3, 2e3)]
+            .iter()
+            .map(|&(angle, fx, ax)| RodFrameInstant {
+                crank_angle_deg: angle,
+                time_s: 0.0,
+                a_a_m_s2: [ax, 0.0],
+                omega3_rad_s: 0.0,
+                alpha3_rad_s2: 0.0,
+                gravity_m_s2: [0.0, 0.0],
+                f_a_on_rod_n: [fx, 0.0],
+                f_b_on_rod_n: [-fx, 0.0],
+                gas_force_n: 0.0,
+            })
+            .collect();
+    let history: Vec<CycleInstant> = instants
+        .iter()
+        .map(|i| CycleInstant {
+            crank_angle_deg: i.crank_angle_deg,
+            time_s: 0.0,
+            max_von_mises_away_from_fixed_mpa: 1.0,
+            reaction_b_n: [0.0; 3],
+            dynamics_f_b_n: [0.0; 3],
+        })
+        .collect();
+    let which: Vec<(usize, String)> = (0..3).map(|k| (k, format!("instant {k}"))).collect();
+    let whole_options = cycle_options(None);
+    let half_options = cycle_options(Some(HalfModel {
+        plane_z_mm: 0.0,
+        nodes: half.n_nodes(),
+        elements: half.n_elements(),
+        plane_nodes: m.plane_nodes.len(),
+    }));
+    let solve = |options: &CycleOptions| {
+        contact_instants(
+            &m.whole,
+            &Material::STEEL,
+            &spec,
+            options,
+            &instants,
+            &history,
+            &which,
+        )
+        .unwrap()
+    };
+    let (w, h) = (solve(&whole_options), solve(&half_options));
+    for (a, b) in w.iter().zip(&h) {
+        eprintln!(
+            "{}: whole {:.4} MPa (arcs {:.1}°, {:.1}°), half {:.4} MPa",
+            a.reason, a.contact_mpa, a.arc_a_deg, a.arc_b_deg, b.contact_mpa
+        );
+        assert!(
+            (a.contact_mpa / b.contact_mpa - 1.0).abs() < 1e-8,
+            "{a:?}\n{b:?}"
+        );
+        assert!(
+            (a.arc_a_deg - b.arc_a_deg).abs() < 1e-8 && (a.arc_b_deg - b.arc_b_deg).abs() < 1e-8
+        );
+        assert!((a.peak_pressure_a_mpa / b.peak_pressure_a_mpa - 1.0).abs() < 1e-8);
+        assert!((a.peak_pressure_b_mpa / b.peak_pressure_b_mpa - 1.0).abs() < 1e-8);
+        assert!(a.restraint_moment_rel < 1e-8 && b.restraint_moment_rel < 1e-8);
+    }
+}
+
+fn cycle_options(half_model: Option<HalfModel>) -> CycleOptions {
+    CycleOptions {
+        density_kg_m3: 7850.0,
+        fixed_band_m: DEFAULT_FIXED_BAND_M,
+        singular_edges_m: Vec::new(),
+        singular_band_m: DEFAULT_SINGULAR_BAND_M,
+        endurance_pa: 235e6,
+        ultimate_pa: 470e6,
+        mean_stress: MeanStress::default(),
+        quadrature: QuadratureChoice::Auto,
+        direction_step_deg: DEFAULT_DIRECTION_STEP_DEG,
+        half_model,
+    }
+}
+
+#[test]
 fn a_cycle_instant_without_inertia_is_the_static_contact_case() {
     let (p, mesh) = plate(0.04, 4);
     let spec = contact_spec(&p);
@@ -158,17 +255,7 @@ fn a_cycle_instant_without_inertia_is_the_static_contact_case() {
         f_b_on_rod_n: [-FORCE_N, 0.0],
         gas_force_n: 0.0,
     };
-    let options = CycleOptions {
-        density_kg_m3: 7850.0,
-        fixed_band_m: DEFAULT_FIXED_BAND_M,
-        singular_edges_m: Vec::new(),
-        singular_band_m: DEFAULT_SINGULAR_BAND_M,
-        endurance_pa: 235e6,
-        ultimate_pa: 470e6,
-        mean_stress: MeanStress::default(),
-        quadrature: QuadratureChoice::Auto,
-        direction_step_deg: DEFAULT_DIRECTION_STEP_DEG,
-    };
+    let options = cycle_options(None);
     let linear = CycleInstant {
         crank_angle_deg: 180.0,
         time_s: 0.0,

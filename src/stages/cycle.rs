@@ -73,6 +73,7 @@ pub fn cycle_options(mass: &DesignMass, mesh: &StageMesh, config: &StudyConfig) 
         mean_stress: config.material.mean_stress,
         quadrature: QuadratureChoice::Auto,
         direction_step_deg: DEFAULT_DIRECTION_STEP_DEG,
+        half_model: mesh.half_model.clone(),
     }
 }
 

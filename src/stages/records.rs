@@ -185,6 +185,8 @@ pub struct StageMesh {
     pub singular_edges_m: Vec<[[f64; 3]; 2]>,
     pub fixed_band_m: f64,
     pub singular_band_m: f64,
+    /// The half model `mesh` was mirrored from (`None`: the whole was solved).
+    pub half_model: Option<crate::rod::records::HalfModel>,
 }
 
 /// The cycle record of one design (JSON fields named by the issue that asked for them).

@@ -193,7 +193,7 @@ impl NodalFrames {
 }
 
 /// How the columns of S are computed.
-pub enum Compliance<'a> {
+pub enum Compliance {
     /// From the trailing block L₂₂ of the factor of K' (radial equations last).
     Trailing {
         /// Per row: (trailing index of node a's radial equation, D_ba) over the row's weights.
@@ -203,8 +203,6 @@ pub enum Compliance<'a> {
     },
     /// One solve with the factor of K per column, `BLOCK` at a time.
     Solves {
-        /// The factor of K.
-        factor: &'a CholeskyFactor,
         /// Equations.
         n_eq: usize,
         /// Per row: (equation, coefficient) of C.
@@ -212,14 +210,14 @@ pub enum Compliance<'a> {
     },
 }
 
-impl<'a> Compliance<'a> {
+impl Compliance {
     /// From the factor of K' ordered by [`NodalFrames::order_last`] (`radial`: the radial
     /// equation of each frame, in row order).
     pub fn trailing(
         factor: &CholeskyFactor,
         walls: &[Wall],
         radial: &[usize],
-    ) -> Result<Compliance<'a>> {
+    ) -> Result<Compliance> {
         let m = radial.len();
         let (old, l22) = factor.trailing_block(m);
         let mut pos = std::collections::HashMap::with_capacity(m);
@@ -249,14 +247,9 @@ impl<'a> Compliance<'a> {
         Ok(Compliance::Trailing { c_r, l22 })
     }
 
-    /// Columns solved with `factor` (K, unrotated); `eqs[w][a]`: the equations of wall w's
-    /// node a.
-    pub fn solves(
-        factor: &'a CholeskyFactor,
-        n_eq: usize,
-        walls: &[Wall],
-        eqs: &[Vec<[Option<usize>; 3]>],
-    ) -> Compliance<'a> {
+    /// Columns solved one by one with the factor of K (unrotated); `eqs[w][a]`: the equations
+    /// of wall w's node a.
+    pub fn solves(n_eq: usize, walls: &[Wall], eqs: &[Vec<[Option<usize>; 3]>]) -> Compliance {
         let c = walls
             .iter()
             .enumerate()
@@ -271,11 +264,12 @@ impl<'a> Compliance<'a> {
                 })
             })
             .collect();
-        Compliance::Solves { factor, n_eq, c }
+        Compliance::Solves { n_eq, c }
     }
 
-    /// The columns S[:, j] (each of length m) of the rows `js`.
-    pub fn columns(&self, js: &[usize]) -> Vec<Vec<f64>> {
+    /// The columns S[:, j] (each of length m) of the rows `js`; `factor` is K's (used by
+    /// [`Compliance::Solves`] only).
+    pub fn columns(&self, factor: &CholeskyFactor, js: &[usize]) -> Vec<Vec<f64>> {
         let apply = |c: &[Vec<(usize, f64)>], x: &dyn Fn(usize) -> f64| -> Vec<f64> {
             c.iter()
                 .map(|row| row.iter().map(|&(i, d)| d * x(i)).sum())
@@ -297,7 +291,7 @@ impl<'a> Compliance<'a> {
                     .map(|col| apply(c_r, &|i| x[(i, col)]))
                     .collect()
             }
-            Compliance::Solves { factor, n_eq, c } => {
+            Compliance::Solves { n_eq, c } => {
                 let mut out = Vec::with_capacity(js.len());
                 for chunk in js.chunks(BLOCK) {
                     let mut rhs = vec![0.0; n_eq * chunk.len()];

@@ -8,8 +8,9 @@
 //! face ([`weights`]); the conditions λ_b ≥ 0, G_b ≥ 0, λ_b G_b = 0 hold node by node on the
 //! weighted gaps. The rigid motions of a floating body are held by a statically determinate
 //! support ([`modes`]) whose reaction is reported and must vanish where contact cannot carry
-//! load ([`check`]). K is factorised once; the contact is condensed on the wall nodes and solved
-//! by the primal–dual active-set method ([`lcp`], [`solve`]). Every solution is checked before
+//! load ([`check`]). K is factorised once per body, supports and pins ([`system`], reused for
+//! other loads); the contact is condensed on the wall nodes and solved by the primal–dual
+//! active-set method ([`lcp`], [`solve`]). Every solution is checked before
 //! it is returned: equilibrium, the pin forces' resultants, complementarity, penetration, no
 //! tensile pressure ([`check`]). Pressure, gap, arc, peak and the bore's ovality: [`measures`].
 //!
@@ -25,6 +26,7 @@ pub mod modes;
 pub mod node_to_surface;
 pub mod problem;
 pub mod solve;
+pub mod system;
 pub mod weights;
 
 pub use acceptance::ContactCheck;
@@ -35,3 +37,4 @@ pub use problem::{
     ContactProblem, ContactSolution, ContactTimings, ContactTolerances, CylinderContact, Restraint,
 };
 pub use solve::solve_contact;
+pub use system::ContactSystem;

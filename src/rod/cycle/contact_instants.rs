@@ -5,6 +5,9 @@
 //! |F_A,y|) and the linear cycle's worst instant, and its judged peak compared with the linear
 //! cycle's at the same instant.
 //!
+//! All instants share one factorisation of K ([`ContactSystem`]); a mirror-symmetric rod is solved
+//! on its half model (u_z = 0 on the plane, half the loads) and mirrored for the stresses.
+//!
 //! At an instant the rod carries the d'Alembert body force ρ (g − a_P) (the four body-force unit
 //! loads of [`super::unit_cases`] combined with the instant's coefficients), pin A a rigid cylinder
 //! of radius r_A − c_A with the crank's force F_A on it, and is held by pin B, a fixed rigid
@@ -19,14 +22,16 @@ use super::unit_cases::{CycleOptions, coefficients};
 use super::{CycleInstant, CycleSolution};
 use crate::fem::body_force::{BodyShape, body_force_load};
 use crate::fem::boundary::{boundary_faces, norm};
-use crate::fem::contact::{ContactProblem, ContactTolerances, PinMotion, solve_contact};
+use crate::fem::contact::{ContactProblem, ContactSystem, ContactTolerances, PinMotion};
 use crate::fem::error::{FemError, Result};
 use crate::fem::material::Material;
 use crate::fem::mesh::TetMesh;
+use crate::fem::mesh::mirror::mirror;
 use crate::fem::stress::{peak_nodal, stress_field};
 use crate::mechanism::RodFrameInstant;
 use crate::rod::bores::{BoreSpec, find_bores};
 use crate::rod::contact_cases::{clearances_m, pin_in};
+use crate::rod::half_model::mirror_plane_tolerance;
 use crate::rod::judged::{Bands, judged_nodes};
 
 /// One instant solved with contact, beside the linear cycle's figure at the same instant.
@@ -114,7 +119,9 @@ pub fn instants_that_matter(
 }
 
 /// Solves the rod `mesh` with contact at each instant of `which` (indices into `instants`, with
-/// reasons), against the linear cycle's `history`.
+/// reasons), against the linear cycle's `history`. On a half model ([`CycleOptions::half_model`])
+/// the half is solved (half the loads, u_z = 0 on the plane) and mirrored; the instants share one
+/// factorised system ([`ContactSystem`]): only the loads and the pin force change between them.
 pub fn contact_instants(
     mesh: &TetMesh,
     material: &Material,
@@ -124,8 +131,31 @@ pub fn contact_instants(
     history: &[CycleInstant],
     which: &[(usize, String)],
 ) -> Result<Vec<ContactInstant>> {
-    let boundary = boundary_faces(mesh)?;
-    let (loaded, fixed) = find_bores(mesh, &boundary, bores)?;
+    if which.is_empty() {
+        return Ok(Vec::new());
+    }
+    // the mesh solved: the half model with its plane held, or the whole
+    let half = match &options.half_model {
+        Some(h) => {
+            let half = h.half_of(mesh)?;
+            let m = mirror(&half, h.plane_z_m(), mirror_plane_tolerance(&half))?;
+            if m.whole.n_nodes() != mesh.n_nodes() {
+                return Err(FemError::InvalidInput(format!(
+                    "the half model mirrors into {} nodes, the cycle's mesh has {}",
+                    m.whole.n_nodes(),
+                    mesh.n_nodes()
+                )));
+            }
+            Some((half, m))
+        }
+        None => None,
+    };
+    let solved = half.as_ref().map_or(mesh, |(h, _)| h);
+    let share = if half.is_some() { 0.5 } else { 1.0 };
+    let held: Vec<(usize, f64)> = half.as_ref().map_or(Vec::new(), |(_, m)| {
+        m.plane_nodes.iter().map(|&n| (3 * n + 2, 0.0)).collect()
+    });
+    let (loaded, fixed) = find_bores(solved, &boundary_faces(solved)?, bores)?;
     let axis = bores.unit_axis()?;
     let [c_a, c_b] = clearances_m(bores, &loaded, &fixed);
     let body: Vec<Vec<f64>> = [
@@ -135,10 +165,12 @@ pub fn contact_instants(
         BodyShape::AngularAccel,
     ]
     .into_iter()
-    .map(|shape| body_force_load(mesh, options.density_kg_m3, shape))
+    .map(|shape| body_force_load(solved, options.density_kg_m3, shape))
     .collect();
+    // the judged region on the whole mesh, as the linear cycle's
+    let (_, fixed_whole) = find_bores(mesh, &boundary_faces(mesh)?, bores)?;
     let bands = Bands {
-        fixed_faces: &fixed.faces,
+        fixed_faces: &fixed_whole.faces,
         fixed_band_m: options.fixed_band_m,
         singular_edges_m: &options.singular_edges_m,
         singular_band_m: options.singular_band_m,
@@ -147,42 +179,57 @@ pub fn contact_instants(
     let centre_distance = norm(std::array::from_fn(|j| {
         fixed.centre_m[j] - loaded.centre_m[j]
     }));
+    let problem_at = |inst: &RodFrameInstant| -> Result<ContactProblem<'_>> {
+        let c = coefficients(inst);
+        let mut loads = vec![0.0; solved.n_dofs()];
+        for (b, coeff) in body.iter().zip(&c[2..]) {
+            for (l, v) in loads.iter_mut().zip(b) {
+                *l += coeff * v;
+            }
+        }
+        let f_a = [
+            share * inst.f_a_on_rod_n[0],
+            share * inst.f_a_on_rod_n[1],
+            0.0,
+        ];
+        Ok(ContactProblem {
+            mesh: solved,
+            material: *material,
+            quadrature: options.quadrature,
+            prescribed: held.clone(),
+            loads,
+            cylinders: vec![
+                pin_in(&loaded, axis, c_a, PinMotion::Force(f_a))?,
+                pin_in(&fixed, axis, c_b, PinMotion::Fixed)?,
+            ],
+            tolerances: ContactTolerances {
+                free_mode_reaction_rel: None,
+                ..ContactTolerances::default()
+            },
+        })
+    };
+    let instant = |k: usize| {
+        instants.get(k).ok_or_else(|| {
+            FemError::InvalidInput(format!("contact instant {k} is not in the cycle"))
+        })
+    };
+    let system = ContactSystem::new(&problem_at(instant(which[0].0)?)?)?;
     which
         .iter()
         .map(|(k, reason)| {
-            let inst = instants.get(*k).ok_or_else(|| {
-                FemError::InvalidInput(format!("contact instant {k} is not in the cycle"))
-            })?;
-            let c = coefficients(inst);
-            let mut loads = vec![0.0; mesh.n_dofs()];
-            for (b, coeff) in body.iter().zip(&c[2..]) {
-                for (l, v) in loads.iter_mut().zip(b) {
-                    *l += coeff * v;
-                }
-            }
-            let f_a = [inst.f_a_on_rod_n[0], inst.f_a_on_rod_n[1], 0.0];
-            let problem = ContactProblem {
-                mesh,
-                material: *material,
-                quadrature: options.quadrature,
-                prescribed: Vec::new(),
-                loads,
-                cylinders: vec![
-                    pin_in(&loaded, axis, c_a, PinMotion::Force(f_a))?,
-                    pin_in(&fixed, axis, c_b, PinMotion::Fixed)?,
-                ],
-                tolerances: ContactTolerances {
-                    free_mode_reaction_rel: None,
-                    ..ContactTolerances::default()
-                },
-            };
-            let s = solve_contact(&problem).map_err(|e| {
+            let inst = instant(*k)?;
+            let problem = problem_at(inst)?;
+            let s = system.solve(&problem).map_err(|e| {
                 FemError::Problem(format!(
                     "the cycle with contact at φ = {:.0}° ({reason}): {e}",
                     inst.crank_angle_deg
                 ))
             })?;
-            let stress = stress_field(mesh, material, &s.displacements)?;
+            let u = match &half {
+                Some((_, m)) => m.mirror_vector(&s.displacements),
+                None => s.displacements.clone(),
+            };
+            let stress = stress_field(mesh, material, &u)?;
             let peak = peak_nodal(mesh, &stress.von_mises_averaged(), Some(&judged));
             let linear = history
                 .get(*k)
@@ -191,6 +238,7 @@ pub fn contact_instants(
                 })?
                 .max_von_mises_away_from_fixed_mpa;
             let m = s.restraint.moment_nm;
+            let f_a = [inst.f_a_on_rod_n[0], inst.f_a_on_rod_n[1], 0.0];
             let contact_mpa = peak.value * 1e-6;
             Ok(ContactInstant {
                 reason: reason.clone(),
@@ -205,7 +253,7 @@ pub fn contact_instants(
                 peak_pressure_a_mpa: s.cylinders[0].peak_pressure_pa * 1e-6,
                 peak_pressure_b_mpa: s.cylinders[1].peak_pressure_pa * 1e-6,
                 restraint_moment_rel: norm(m)
-                    / (norm(f_a) * centre_distance).max(f64::MIN_POSITIVE),
+                    / (share * norm(f_a) * centre_distance).max(f64::MIN_POSITIVE),
             })
         })
         .collect()

@@ -25,6 +25,7 @@ fn options() -> CycleOptions {
         mean_stress: MeanStress::Goodman,
         quadrature: QuadratureChoice::Auto,
         direction_step_deg: DEFAULT_DIRECTION_STEP_DEG,
+        half_model: None,
     }
 }
 

@@ -64,6 +64,9 @@ pub struct CycleOptions {
     /// With a cosine bore load: the spacing of the pin's unit directions, degrees (must divide
     /// 360; [`DEFAULT_DIRECTION_STEP_DEG`]).
     pub direction_step_deg: f64,
+    /// The half model the mesh was mirrored from, if it was: the cycle's contact instants are
+    /// solved on it ([`super::contact_instants`]).
+    pub half_model: Option<crate::rod::records::HalfModel>,
 }
 
 /// The default spacing of the cosine bore load's unit directions: 5° (72 directions).

@@ -215,6 +215,7 @@ impl Setup {
                 singular_edges_m: self.singular_edges,
                 fixed_band_m: config.fem.fixed_band_mm * 1e-3,
                 singular_band_m: config.fem.singular_band_mm * 1e-3,
+                half_model: solution.result.half_model.clone(),
             },
             solution,
             buckling_run: None,
