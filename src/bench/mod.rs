@@ -7,6 +7,7 @@ pub mod fem_adaptive;
 pub mod fem_convergence;
 pub mod fem_mesh;
 pub mod fem_rod;
+pub mod load_models;
 pub mod mass;
 
 use std::time::{Duration, Instant};

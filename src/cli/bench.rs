@@ -105,6 +105,23 @@ pub enum BenchCommand {
         #[arg(long)]
         json: bool,
     },
+    /// Speed against error of the three bore loads (uniform, cosine, contact): the static cases
+    /// on stage 3's final mesh under each, timed, their judged peaks against contact's.
+    LoadModels {
+        /// The STL design.
+        design: PathBuf,
+        /// Runs per model (the median time is reported).
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+        /// One fixed mesh of this size [mm] instead of the study's adaptive refinement.
+        #[arg(long)]
+        size: Option<f64>,
+        /// Settings file (as for `study`; e.g. the engine example).
+        #[arg(long)]
+        config: Option<PathBuf>,
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 pub fn run(command: BenchCommand) -> Result<i32> {
@@ -186,6 +203,53 @@ pub fn run(command: BenchCommand) -> Result<i32> {
                     b.rows,
                     b.columns,
                     b.phases
+                );
+            }
+            Ok(0)
+        }
+        BenchCommand::LoadModels {
+            design,
+            repeats,
+            size,
+            config,
+            json,
+        } => {
+            let config = crate::config::StudyConfig::load(config.as_deref())?;
+            let mode = match size {
+                Some(h) => crate::stages::fem::MeshMode::Fixed(h),
+                None => crate::stages::fem::MeshMode::from_config(&config),
+            };
+            let b = crate::bench::load_models::bench_load_models(&design, &config, &mode, repeats)?;
+            if json {
+                outln!("{}", serde_json::to_string_pretty(&b)?);
+                return Ok(0);
+            }
+            outln!(
+                "{}: {} nodes{}; estimated discretisation error {}",
+                b.design,
+                b.nodes,
+                if b.half_model { " (half model)" } else { "" },
+                b.discretisation_error_rel
+                    .iter()
+                    .map(|(n, e)| format!("{n} {:.2} %", 100.0 * e))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+            outln!("| model | time [s] | × uniform | judged peaks [MPa] | from contact |");
+            outln!("|---|---|---|---|---|");
+            for r in &b.runs {
+                let cell = |f: &dyn Fn(&(String, f64, f64)) -> String| {
+                    r.cases.iter().map(f).collect::<Vec<_>>().join(", ")
+                };
+                outln!(
+                    "| {} | {:.2} | {:.2} | {} | {} |",
+                    r.model,
+                    r.seconds,
+                    r.time_vs_uniform,
+                    r.error
+                        .clone()
+                        .unwrap_or_else(|| cell(&|c| format!("{} {:.2}", c.0, c.1))),
+                    cell(&|c| format!("{} {:.1} %", c.0, 100.0 * c.2))
                 );
             }
             Ok(0)
