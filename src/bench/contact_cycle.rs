@@ -73,7 +73,7 @@ pub fn bench_contact_cycle(
             which,
         )
         .context("contact at the instants")?;
-        Ok((r, t.elapsed().as_secs_f64()))
+        Ok((r.instants, t.elapsed().as_secs_f64()))
     };
     let (chosen, chosen_s) = run(&instants_that_matter(&instants, c.cycle.max_instant))?;
     let n = instants.len();

@@ -21,12 +21,14 @@ use crate::fem::QuadratureChoice;
 use crate::fem::body_force::mesh_mass_properties;
 use crate::fem::material::Material;
 use crate::mechanism::{RodFrameInstant, rod_frame_engine_cycle};
-use crate::rod::cycle::contact_instants::contact_at_instants_that_matter;
+use crate::rod::cycle::contact_fatigue::{ContactFatigue, contact_fatigue};
+use crate::rod::cycle::contact_instants::{ContactInstant, contact_instants, instants_that_matter};
 use crate::rod::cycle::{
     CycleOptions, CycleSolution, DEFAULT_DIRECTION_STEP_DEG, LocalFatigueSolution, PinBasis,
     UnitSolutions, combine, local_fatigue, rod_inertia_of, unit_solutions_for,
 };
 use crate::rod::fatigue::MeanStress;
+use crate::rod::fatigue::signed_von_mises;
 use anyhow::{Context, Result};
 use std::time::Instant;
 
@@ -98,6 +100,50 @@ pub fn cycle_instants(
     .with_context(context)
 }
 
+/// The cycle with contact at the instants that matter ([`instants_that_matter`]) and the fatigue
+/// factor from them beside the linear cycle's at the same instants ([`contact_fatigue`]).
+fn contact_figures(
+    mesh: &StageMesh,
+    material: &Material,
+    options: &CycleOptions,
+    instants: &[RodFrameInstant],
+    units: &UnitSolutions,
+    cycle: &CycleSolution,
+) -> crate::fem::error::Result<(Vec<ContactInstant>, ContactFatigue)> {
+    let which = instants_that_matter(instants, cycle.max_instant);
+    let solved = contact_instants(
+        &mesh.mesh,
+        material,
+        &mesh.bores,
+        options,
+        instants,
+        &cycle.history,
+        &which,
+    )?;
+    let linear = which
+        .iter()
+        .map(|(k, _)| {
+            let t = units.terms(&instants[*k])?;
+            Ok((0..mesh.mesh.n_nodes())
+                .map(|n| signed_von_mises(&units.stress_at(n, &t)))
+                .collect())
+        })
+        .collect::<crate::fem::error::Result<Vec<Vec<f64>>>>()?;
+    let fatigue = contact_fatigue(
+        &solved.signed_von_mises_pa,
+        &linear,
+        &units.judged,
+        options,
+        cycle.fatigue_safety_factor[cycle.fatigue_node],
+        mesh.mesh.nodes(),
+        which
+            .iter()
+            .map(|(k, _)| instants[*k].crank_angle_deg)
+            .collect(),
+    )?;
+    Ok((solved.instants, fatigue))
+}
+
 /// Runs the cycle stage on stage 3's mesh (writes nothing).
 pub fn cycle(mass: &DesignMass, mesh: &StageMesh, config: &StudyConfig) -> Result<CycleOutcome> {
     let start = Instant::now();
@@ -111,20 +157,14 @@ pub fn cycle(mass: &DesignMass, mesh: &StageMesh, config: &StudyConfig) -> Resul
     let span_deg = if gas.is_some() { 720.0 } else { 360.0 };
     let cycle = combine(&units, &instants, &options).with_context(context)?;
     // the contact instants are figures beside the linear cycle: their failure is said, not fatal
-    let (contact_instants, contact_instants_error) = if config.fem.load_model_error {
-        match contact_at_instants_that_matter(
-            &mesh.mesh,
-            &material,
-            &mesh.bores,
-            &options,
-            &instants,
-            &cycle,
-        ) {
-            Ok(v) => (v, None),
-            Err(e) => (Vec::new(), Some(format!("{e}"))),
+    let (contact_instants, contact_fatigue, contact_instants_error) = if config.fem.load_model_error
+    {
+        match contact_figures(mesh, &material, &options, &instants, &units, &cycle) {
+            Ok((v, f)) => (v, Some(f), None),
+            Err(e) => (Vec::new(), None, Some(format!("{e}"))),
         }
     } else {
-        (Vec::new(), None)
+        (Vec::new(), None, None)
     };
     let local_start = Instant::now();
     let terms = instants
@@ -184,6 +224,7 @@ pub fn cycle(mass: &DesignMass, mesh: &StageMesh, config: &StudyConfig) -> Resul
         },
         mean_stress: config.material.mean_stress,
         contact_instants,
+        contact_fatigue,
         contact_instants_error,
         local_fatigue_safety_factor: Some(local.critical().assessment.safety_factor),
         local_fatigue: Some(local_record(

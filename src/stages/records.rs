@@ -173,6 +173,12 @@ pub struct DesignFem {
     /// only with a pressure trace (`[engine] pressure_trace`), absent otherwise.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub buckling_load_factor: Option<f64>,
+    /// λ₁ of the same case with the compression entering bore A through contact (a rigid pin at
+    /// its clearance, bore B clamped; [`crate::rod::buckling::rod_buckling_contact`]): computed
+    /// beside `buckling_load_factor` when `[fem] load_model_error` is on; the verdict stays on
+    /// `buckling_load_factor`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub buckling_load_factor_contact: Option<f64>,
 }
 
 /// The mesh stage 3 ended on, in the rod frame (m), with what a later stage on the same mesh
@@ -239,6 +245,10 @@ pub struct DesignCycle {
     /// (`[fem] load_model_error = false`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub contact_instants: Vec<crate::rod::cycle::contact_instants::ContactInstant>,
+    /// The fatigue factor from the contact instants beside the linear cycle's at the same
+    /// instants ([`crate::rod::cycle::contact_fatigue`]); absent where the instants are.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact_fatigue: Option<crate::rod::cycle::contact_fatigue::ContactFatigue>,
     /// Why the contact instants are missing where they were asked for and could not be solved.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub contact_instants_error: Option<String>,

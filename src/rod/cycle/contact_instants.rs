@@ -18,8 +18,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::CycleInstant;
 use super::unit_cases::{CycleOptions, coefficients};
-use super::{CycleInstant, CycleSolution};
 use crate::fem::body_force::{BodyShape, body_force_load};
 use crate::fem::boundary::{boundary_faces, norm};
 use crate::fem::contact::{ContactProblem, ContactSystem, ContactTolerances, PinMotion};
@@ -31,6 +31,7 @@ use crate::fem::stress::{peak_nodal, stress_field};
 use crate::mechanism::RodFrameInstant;
 use crate::rod::bores::{BoreSpec, find_bores};
 use crate::rod::contact_cases::{clearances_m, pin_in};
+use crate::rod::fatigue::signed_von_mises;
 use crate::rod::half_model::mirror_plane_tolerance;
 use crate::rod::judged::{Bands, judged_nodes};
 
@@ -57,6 +58,15 @@ pub struct ContactInstant {
     pub peak_pressure_b_mpa: f64,
     /// |moment| of the support of the rotation about pin B / (|F_A| × centre distance).
     pub restraint_moment_rel: f64,
+}
+
+/// The instants solved with contact, and the signed von Mises stress (Pa) of each at every node
+/// of the mesh (the nodally averaged tensor's, [`crate::rod::fatigue::signed_von_mises`]), for the
+/// fatigue factor with contact ([`super::contact_fatigue`]).
+#[derive(Clone, Debug)]
+pub struct ContactInstants {
+    pub instants: Vec<ContactInstant>,
+    pub signed_von_mises_pa: Vec<Vec<f64>>,
 }
 
 /// Instants of the cycle closer than this (degrees of crank angle, across the cycle's end too) are
@@ -130,9 +140,12 @@ pub fn contact_instants(
     instants: &[RodFrameInstant],
     history: &[CycleInstant],
     which: &[(usize, String)],
-) -> Result<Vec<ContactInstant>> {
+) -> Result<ContactInstants> {
     if which.is_empty() {
-        return Ok(Vec::new());
+        return Ok(ContactInstants {
+            instants: Vec::new(),
+            signed_von_mises_pa: Vec::new(),
+        });
     }
     // the mesh solved: the half model with its plane held, or the whole
     let half = match &options.half_model {
@@ -214,7 +227,7 @@ pub fn contact_instants(
         })
     };
     let system = ContactSystem::new(&problem_at(instant(which[0].0)?)?)?;
-    which
+    let solved: Vec<(ContactInstant, Vec<f64>)> = which
         .iter()
         .map(|(k, reason)| {
             let inst = instant(*k)?;
@@ -240,7 +253,8 @@ pub fn contact_instants(
             let m = s.restraint.moment_nm;
             let f_a = [inst.f_a_on_rod_n[0], inst.f_a_on_rod_n[1], 0.0];
             let contact_mpa = peak.value * 1e-6;
-            Ok(ContactInstant {
+            let signed = stress.averaged.iter().map(signed_von_mises).collect();
+            let record = ContactInstant {
                 reason: reason.clone(),
                 crank_angle_deg: inst.crank_angle_deg,
                 f_a_on_rod_n: inst.f_a_on_rod_n,
@@ -254,29 +268,13 @@ pub fn contact_instants(
                 peak_pressure_b_mpa: s.cylinders[1].peak_pressure_pa * 1e-6,
                 restraint_moment_rel: norm(m)
                     / (share * norm(f_a) * centre_distance).max(f64::MIN_POSITIVE),
-            })
+            };
+            Ok((record, signed))
         })
-        .collect()
-}
-
-/// [`contact_instants`] at the instants that matter ([`instants_that_matter`]) of the linear
-/// cycle `cycle`.
-pub fn contact_at_instants_that_matter(
-    mesh: &TetMesh,
-    material: &Material,
-    bores: &BoreSpec,
-    options: &CycleOptions,
-    instants: &[RodFrameInstant],
-    cycle: &CycleSolution,
-) -> Result<Vec<ContactInstant>> {
-    let which = instants_that_matter(instants, cycle.max_instant);
-    contact_instants(
-        mesh,
-        material,
-        bores,
-        options,
+        .collect::<Result<_>>()?;
+    let (instants, signed_von_mises_pa) = solved.into_iter().unzip();
+    Ok(ContactInstants {
         instants,
-        &cycle.history,
-        &which,
-    )
+        signed_von_mises_pa,
+    })
 }

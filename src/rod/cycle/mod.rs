@@ -34,6 +34,7 @@
 //! not the cosine about θ itself: that is the interpolation's only error, O(Δ²), measured in the
 //! tests against direct solves (see [`tests`]).
 
+pub mod contact_fatigue;
 pub mod contact_instants;
 pub mod local_fatigue;
 mod unit_cases;

@@ -171,6 +171,9 @@ pub fn fem_and_buckling(
             .result
             .with_context(|| format!("{}: buckling", design.file.display()))?;
         apply_buckling(&mut outcome, run.compression_n, b, Some(config));
+        if config.fem.load_model_error {
+            add_contact_buckling(&mut outcome, run.compression_n, config);
+        }
         // an analysis under another load asked for besides (`fem --force`) runs after
         outcome.buckling_run = buckling_n.map(|n| buckling_run(&outcome, config, n));
     }
@@ -353,6 +356,30 @@ fn rod_buckling_with(
         &BucklingOptions::default(),
         system,
     )
+}
+
+/// The buckling factor with the compression entering bore A through contact
+/// ([`crate::rod::buckling::rod_buckling_contact`]) beside the record's, on the kept factorisation
+/// (the same supports: bore B clamped); a figure beside the analysis: its failure is a warning.
+fn add_contact_buckling(outcome: &mut FemOutcome, compression_n: f64, config: &StudyConfig) {
+    let stage = &outcome.mesh;
+    let b = crate::rod::buckling::rod_buckling_contact(
+        &stage.mesh,
+        &Material::from(&config.fem),
+        &stage.bores,
+        compression_n,
+        RodOptions::default().quadrature,
+        &BucklingOptions::default(),
+        outcome.solution.system.as_deref(),
+    );
+    match b {
+        Ok(b) => outcome.record.buckling_load_factor_contact = Some(b.load_factor),
+        Err(e) => {
+            let w = format!("the buckling factor under contact was not computed: {e}");
+            outcome.record.fem.warnings.push(w.clone());
+            outcome.solution.result.warnings.push(w);
+        }
+    }
 }
 
 /// A buckling analysis' factor into the record, its mode into the fields (the report writes

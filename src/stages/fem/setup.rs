@@ -208,6 +208,7 @@ impl Setup {
                 fem: solution.result.clone(),
                 criterion,
                 buckling_load_factor: None,
+                buckling_load_factor_contact: None,
             },
             mesh: StageMesh {
                 mesh,
