@@ -305,6 +305,26 @@ fn design_section(s: &mut String, r: &RankRow, out: &Path) {
                 c.ultimate_mpa
             ),
         ));
+        if !c.contact_instants.is_empty() {
+            props.push(("cycle with pin contact", contact_cycle_line(c)));
+        }
+        if let Some(e) = &c.contact_instants_error {
+            props.push(("cycle with pin contact", format!("not solved: {e}")));
+        }
+    }
+    if let Some(f) = r.fem
+        && let Some(b) = f.buckling_load_factor
+    {
+        props.push((
+            "buckling load factor",
+            match f.buckling_load_factor_contact {
+                Some(c) => format!(
+                    "{b:.2} (uniform traction); {c:.2} with the compression entering bore A through contact ({:+.1} %)",
+                    100.0 * (c / b - 1.0)
+                ),
+                None => format!("{b:.2}"),
+            },
+        ));
     }
     s.push_str("<table class=\"props\">\n");
     for (k, v) in props {
@@ -445,6 +465,37 @@ fn contact_line(
         k.clearance_a_um,
         k.clearance_b_um
     )
+}
+
+/// The cycle's contact instants against the linear cycle at the same instants, and the fatigue
+/// factor they give.
+fn contact_cycle_line(c: &crate::stages::records::DesignCycle) -> String {
+    let instants: Vec<String> = c
+        .contact_instants
+        .iter()
+        .map(|i| {
+            format!(
+                "φ = {:.0}° ({}): {:.2} MPa against {:.2} MPa linear ({:+.0} %), arcs {:.0}° / {:.0}°",
+                i.crank_angle_deg,
+                i.reason,
+                i.contact_mpa,
+                i.linear_mpa,
+                100.0 * i.change_rel,
+                i.arc_a_deg,
+                i.arc_b_deg
+            )
+        })
+        .collect();
+    let fatigue = c.contact_fatigue.as_ref().map_or(String::new(), |f| {
+        format!(
+            "; fatigue factor over these instants {:.2} with contact against {:.2} linear ({:+.0} %; the linear cycle over every instant {:.2})",
+            f.contact_factor,
+            f.linear_factor_at_instants,
+            100.0 * f.change_rel,
+            f.linear_factor
+        )
+    });
+    format!("{}{fatigue}", instants.join("; "))
 }
 
 /// The integrators' work–precision plots and stage 3's speed–error plots, when present.
