@@ -319,12 +319,26 @@ pub const COLUMNS: &[Column] = &[
         key: "fatigue_goodman",
         shown: Shown::Always,
         cells: Cells::Design {
-            csv: &[("fatigue_safety_factor", |r| {
-                Value::Num(r.cycle.map(|c| c.fatigue_safety_factor))
-            })],
-            table: Some(("Goodman fatigue factor", |r| {
-                r.cycle
-                    .map_or_else(dash, |c| format!("{:.2}", c.fatigue_safety_factor))
+            csv: &[
+                ("fatigue_safety_factor", |r| {
+                    Value::Num(r.cycle.map(|c| c.fatigue_safety_factor))
+                }),
+                ("contact_fatigue_safety_factor", |r| {
+                    Value::Num(
+                        r.cycle
+                            .and_then(|c| c.contact_fatigue.as_ref())
+                            .map(|f| f.contact_factor),
+                    )
+                }),
+            ],
+            table: Some(("Goodman fatigue factor (with contact)", |r| {
+                r.cycle.map_or_else(dash, |c| {
+                    let contact = c
+                        .contact_fatigue
+                        .as_ref()
+                        .map_or(String::new(), |f| format!(" ({:.2})", f.contact_factor));
+                    format!("{:.2}{contact}", c.fatigue_safety_factor)
+                })
             })),
         },
     },
@@ -346,13 +360,22 @@ pub const COLUMNS: &[Column] = &[
         key: "buckling",
         shown: Shown::Buckling,
         cells: Cells::Design {
-            csv: &[("buckling_load_factor", |r| {
-                Value::Num(r.fem.and_then(|f| f.buckling_load_factor))
-            })],
-            table: Some(("buckling load factor", |r| {
-                r.fem
-                    .and_then(|f| f.buckling_load_factor)
-                    .map_or_else(dash, |l| format!("{l:.2}"))
+            csv: &[
+                ("buckling_load_factor", |r| {
+                    Value::Num(r.fem.and_then(|f| f.buckling_load_factor))
+                }),
+                ("buckling_load_factor_contact", |r| {
+                    Value::Num(r.fem.and_then(|f| f.buckling_load_factor_contact))
+                }),
+            ],
+            table: Some(("buckling load factor (with contact)", |r| {
+                r.fem.map_or_else(dash, |f| {
+                    let contact = f
+                        .buckling_load_factor_contact
+                        .map_or(String::new(), |c| format!(" ({c:.2})"));
+                    f.buckling_load_factor
+                        .map_or_else(dash, |l| format!("{l:.2}{contact}"))
+                })
             })),
         },
     },
