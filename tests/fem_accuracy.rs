@@ -76,7 +76,7 @@ fn adaptive_record(
     work: &std::path::Path,
 ) -> rodstudy::stages::records::DesignFem {
     let design = stages::mass::load(stl).unwrap();
-    let mode = MeshMode::Adaptive(AdaptiveMeshing::new(&config.fem, config.fem.target_error));
+    let mode = MeshMode::Adaptive(AdaptiveMeshing::new(config.fem.target_error));
     stages::fem::fem(
         &design,
         &stages::fem::FemLoads::of_design(&design, config)

@@ -420,7 +420,7 @@ fn curved_tet10_on_the_step_fillet_rod() {
             .with_force(data["force_n"].as_f64().unwrap()),
         &config,
         &dir.path().join("work"),
-        &MeshMode::Adaptive(AdaptiveMeshing::new(&config.fem, 0.03)),
+        &MeshMode::Adaptive(AdaptiveMeshing::new(0.03)),
     )
     .unwrap()
     .record;
@@ -473,7 +473,7 @@ fn curved_tet10_on_the_step_fillet_rod() {
             .with_force(data["force_n"].as_f64().unwrap()),
         &config,
         &dir.path().join("work-stl"),
-        &MeshMode::Adaptive(AdaptiveMeshing::new(&config.fem, 0.03)),
+        &MeshMode::Adaptive(AdaptiveMeshing::new(0.03)),
     )
     .unwrap()
     .record;
@@ -531,7 +531,7 @@ fn a_small_fillet_cut_into_45_degree_facets_is_refined_not_excluded() {
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     }
     let config = StudyConfig::default();
-    let adaptive = MeshMode::Adaptive(AdaptiveMeshing::new(&config.fem, 0.03));
+    let adaptive = MeshMode::Adaptive(AdaptiveMeshing::new(0.03));
     let run = |name: &str, mode: &MeshMode| {
         let design = stages::mass::load(&dir.path().join(format!("{name}.stl"))).unwrap();
         stages::fem::fem(

@@ -57,7 +57,7 @@ pub fn run(args: CycleArgs) -> Result<i32> {
     )?;
     let mut f = stages::fem::fem(
         &design,
-        &stages::fem::FemLoads::from_records(&mass, &dynamics, &config),
+        &stages::fem::FemLoads::from_records(&mass, &dynamics),
         &config,
         &args.out.join("mesh"),
         &mode,

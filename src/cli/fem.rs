@@ -110,7 +110,7 @@ pub fn run(args: FemArgs) -> Result<i32> {
     let buckling_n = match (args.no_buckling, settings.force_n) {
         (true, _) => None,
         (false, Some(f)) => Some(f),
-        (false, None) if settings.engine => None,
+        (false, None) if loads.engine => None,
         (false, None) => Some(loads.compression_n),
     };
     let mut outcome = stages::fem::fem_and_buckling(
@@ -348,7 +348,7 @@ fn refine(
          bore and the sharp edges left out)\n",
         args.design.display(),
         force,
-        if settings.engine {
+        if loads.engine {
             " (F_x; F_y carries the engine's largest pin force across the rod)"
         } else {
             " (both cases)"

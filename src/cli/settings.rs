@@ -18,10 +18,6 @@ pub struct DesignSettings {
     pub config: StudyConfig,
     /// How stage 3 meshes: the user's mesh (`--mesh`), else the configuration's choice.
     pub mode: MeshMode,
-    /// The engine study (`[engine] pressure_trace` given): the F_y case carries the cycle's
-    /// largest pin force across the rod, and stage 3 judges buckling under the peak compression
-    /// itself.
-    pub engine: bool,
     /// `--force` (N), checked positive; `None`: the design's peak pin force.
     pub force_n: Option<f64>,
 }
@@ -41,7 +37,6 @@ impl DesignSettings {
             bail!("--force must be a positive number of newtons, got {f}");
         }
         Ok(DesignSettings {
-            engine: config.engine.pressure_trace.is_some(),
             config,
             mode,
             force_n,

@@ -3,7 +3,8 @@
 //! the designs concerned.
 //!
 //! The key is the SHA-256 of the program version, the program itself ([`program_fingerprint`]:
-//! the running executable and the pipeline's mesher scripts), the configuration (as JSON), the
+//! the running executable and the pipeline's Python code stages 1 and 3 run), the configuration
+//! (as JSON), the
 //! bytes of its pressure trace if it has one, the STL bytes and the sidecar bytes. Entries live in
 //! `OUT/.cache/<id>.json` (a study without stage 3: `OUT/.cache/without-fem/<id>.json`), written
 //! atomically.
@@ -15,11 +16,16 @@ use serde::{Serialize, de::DeserializeOwned};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
-/// The pipeline scripts whose code stage 1 and stage 3 run.
-const PIPELINE_SCRIPTS: [&str; 2] = ["mesh_rod.py", "step_solid.py"];
+/// The pipeline scripts stage 1 and stage 3 run: the mesher, the STEP reader and the design
+/// builder the STEP reader imports.
+const PIPELINE_SCRIPTS: [&str; 3] = ["mesh_rod.py", "step_solid.py", "make_designs.py"];
+
+/// The packages under `pipeline/` those scripts import: every `.py` file in them counts, so a
+/// module added to a package keys the designs apart without a list to keep.
+const PIPELINE_PACKAGES: [&str; 2] = ["meshing", "rod_designs"];
 
 /// SHA-256 of the program a study runs: the bytes of the running executable and of the pipeline
-/// scripts it calls. The version number alone does not change with the code: a study after a
+/// code it calls ([`PIPELINE_SCRIPTS`], [`PIPELINE_PACKAGES`]). The version number alone does not change with the code: a study after a
 /// change of defaults would reuse results the earlier program had made.
 /// Read once per process.
 pub fn program_fingerprint() -> &'static [u8] {
@@ -32,16 +38,31 @@ pub fn program_fingerprint() -> &'static [u8] {
     })
 }
 
-/// SHA-256 of the executable `exe` and of the [`PIPELINE_SCRIPTS`] under `root/pipeline`; a file
-/// that cannot be read keys nothing apart (the version still does).
+/// SHA-256 of the executable `exe`, of the [`PIPELINE_SCRIPTS`] under `root/pipeline` and of the
+/// `.py` files of its [`PIPELINE_PACKAGES`] (in the order of their names, each keyed by its path
+/// in `pipeline/`); a file that cannot be read keys nothing apart (the version still does).
 fn fingerprint_of(exe: Option<&Path>, root: &Path) -> Vec<u8> {
     let mut h = Sha256::new();
     if let Some(bytes) = exe.and_then(|e| std::fs::read(e).ok()) {
         h.update(b"executable");
         h.update(bytes);
     }
-    for name in PIPELINE_SCRIPTS {
-        if let Ok(bytes) = std::fs::read(root.join("pipeline").join(name)) {
+    let pipeline = root.join("pipeline");
+    let mut files: Vec<String> = PIPELINE_SCRIPTS.iter().map(|s| s.to_string()).collect();
+    for package in PIPELINE_PACKAGES {
+        let mut modules: Vec<String> = std::fs::read_dir(pipeline.join(package))
+            .into_iter()
+            .flatten()
+            .flatten()
+            .filter_map(|e| e.file_name().into_string().ok())
+            .filter(|name| name.ends_with(".py"))
+            .map(|name| format!("{package}/{name}"))
+            .collect();
+        modules.sort();
+        files.extend(modules);
+    }
+    for name in files {
+        if let Ok(bytes) = std::fs::read(pipeline.join(&name)) {
             h.update(name.as_bytes());
             h.update(bytes);
         }
@@ -145,5 +166,37 @@ mod tests {
         assert_ne!(f[0], f[2]);
         assert_ne!(fingerprint_of(Some(&exe), roots[0].path()), f[0]);
         assert_eq!(program_fingerprint().len(), 32);
+    }
+
+    /// A module of a pipeline package counts as the scripts do: changed, added or renamed, it
+    /// keys every design apart; a file that is not Python (a `__pycache__` folder, data) does not.
+    #[test]
+    fn the_program_fingerprint_follows_the_pipeline_packages() {
+        let root = tempfile::tempdir().unwrap();
+        let package = root.path().join("pipeline/meshing");
+        std::fs::create_dir_all(&package).unwrap();
+        std::fs::write(package.join("policy.py"), "a = 1\n").unwrap();
+        let before = fingerprint_of(None, root.path());
+        std::fs::create_dir(package.join("__pycache__")).unwrap();
+        std::fs::write(package.join("notes.txt"), "x").unwrap();
+        assert_eq!(fingerprint_of(None, root.path()), before);
+        std::fs::write(package.join("policy.py"), "a = 2\n").unwrap();
+        let changed = fingerprint_of(None, root.path());
+        assert_ne!(changed, before);
+        std::fs::write(package.join("volume.py"), "").unwrap();
+        let added = fingerprint_of(None, root.path());
+        assert_ne!(added, changed);
+        std::fs::rename(package.join("volume.py"), package.join("volumes.py")).unwrap();
+        assert_ne!(fingerprint_of(None, root.path()), added);
+        // the same files in another package count apart
+        let other = tempfile::tempdir().unwrap();
+        let designs = other.path().join("pipeline/rod_designs");
+        std::fs::create_dir_all(&designs).unwrap();
+        std::fs::write(designs.join("policy.py"), "a = 2\n").unwrap();
+        std::fs::write(designs.join("volumes.py"), "").unwrap();
+        assert_ne!(
+            fingerprint_of(None, other.path()),
+            fingerprint_of(None, root.path())
+        );
     }
 }

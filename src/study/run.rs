@@ -286,7 +286,7 @@ fn study_one(
             let context = || format!("{}: FEM", stl.display());
             let mut f = stages::fem::fem(
                 &design,
-                &stages::fem::FemLoads::from_records(&mass, &dynamics, config),
+                &stages::fem::FemLoads::from_records(&mass, &dynamics),
                 config,
                 &work,
                 &MeshMode::from_config(config),

@@ -22,7 +22,7 @@
 
 use super::criterion::{judge_buckling, verdict};
 use super::records::{DesignDynamics, DesignFem, LoadedDesign, StageMesh};
-use crate::config::{FemConfig, StudyConfig};
+use crate::config::StudyConfig;
 use crate::fem::buckling::{BucklingMode, BucklingOptions, BucklingSolution};
 use crate::fem::statics::FactorisedSystem;
 use crate::fem::{Material, TetMesh};
@@ -41,39 +41,26 @@ pub use crate::mesher::policy::FEATURE_ANGLE_DEG;
 pub enum MeshMode {
     /// One gmsh mesh of this size, mm.
     Fixed(f64),
-    /// Adaptive refinement with these settings.
+    /// Adaptive refinement to this target (the sizes and limits: the configuration's `[fem]`).
     Adaptive(AdaptiveMeshing),
     /// The user's volume mesh (in the design's units and pose).
     User(PathBuf),
 }
 
-/// The settings of adaptive refinement (`[fem]` of the configuration, `--target-error`).
-#[derive(Debug, Clone, PartialEq)]
+/// Adaptive refinement to a target: the target error of each case's judged peak. The loop's
+/// sizes and limits (`fem.initial_size_mm`, `max_size_mm`, `min_size_mm`, `step_min_size_mm`,
+/// `max_iterations`, `max_dofs`) are read where they live, the configuration's `[fem]` handed to
+/// the stage beside the mode.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AdaptiveMeshing {
     /// Target estimated relative error of each case's judged peak.
     pub target_error: f64,
-    /// Uniform size of the first mesh, the largest and the smallest size asked for, mm.
-    pub initial_size_mm: f64,
-    pub max_size_mm: f64,
-    pub min_size_mm: f64,
-    /// The smallest size on a STEP's exact geometry, mm.
-    pub step_min_size_mm: f64,
-    pub max_iterations: usize,
-    pub max_dofs: usize,
 }
 
 impl AdaptiveMeshing {
-    /// The configuration's settings, with the target `target_error`.
-    pub fn new(c: &FemConfig, target_error: f64) -> Self {
-        AdaptiveMeshing {
-            target_error,
-            initial_size_mm: c.initial_size_mm,
-            max_size_mm: c.max_size_mm,
-            min_size_mm: c.min_size_mm,
-            step_min_size_mm: c.step_min_size_mm,
-            max_iterations: c.max_iterations,
-            max_dofs: c.max_dofs,
-        }
+    /// Refinement to the target `target_error`.
+    pub fn new(target_error: f64) -> Self {
+        AdaptiveMeshing { target_error }
     }
 }
 
@@ -81,7 +68,7 @@ impl MeshMode {
     /// The configuration's choice: adaptive when `fem.target_error` > 0, else fixed.
     pub fn from_config(config: &StudyConfig) -> Self {
         if config.fem.adaptive() {
-            MeshMode::Adaptive(AdaptiveMeshing::new(&config.fem, config.fem.target_error))
+            MeshMode::Adaptive(AdaptiveMeshing::new(config.fem.target_error))
         } else {
             MeshMode::Fixed(config.fem.mesh_size_mm)
         }
@@ -136,7 +123,7 @@ pub fn fem_and_buckling(
     keep_system: bool,
     buckling_n: Option<f64>,
 ) -> Result<FemOutcome> {
-    let engine = config.engine.pressure_trace.is_some();
+    let engine = loads.engine;
     let engine_n = engine.then_some(loads.compression_n);
     // one analysis beside the geometry check: the engine's, else the one asked for
     let beside = engine_n.or(buckling_n);
@@ -247,7 +234,9 @@ fn crossing_facets_said(design: &LoadedDesign, e: anyhow::Error) -> anyhow::Erro
 }
 
 /// What stage 3 takes from the records of stages 1 and 2: the forces of its load cases and of its
-/// buckling case, and the arcs of the bores.
+/// buckling case, and the arcs of the bores. Whether the study is the engine's (a pressure trace,
+/// read and checked once with the configuration, [`crate::config::EngineConfig::pressure_trace`])
+/// is read from stage 2's record, which holds the cycle's figures exactly then.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FemLoads {
     /// The pin force: the F_x case's magnitude (stage 2's peak pin force, or `fem --force`), N.
@@ -258,6 +247,9 @@ pub struct FemLoads {
     /// The buckling case's compression: with a pressure trace the peak compression along A→B,
     /// else the peak pin force, N.
     pub compression_n: f64,
+    /// The engine study (stage 2 ran the four-stroke cycle with the gas force): stage 3 judges
+    /// buckling under `compression_n` itself.
+    pub engine: bool,
     /// The arcs of the crank-pin bore A and the piston-pin bore B (a partial bore, a big end
     /// without its cap, is loaded or fixed on the arc that exists), degrees.
     pub bore_arcs_deg: [f64; 2],
@@ -265,23 +257,15 @@ pub struct FemLoads {
 
 impl FemLoads {
     /// The loads of stage 3 from the records of stage 1 (`mass`) and stage 2 (`dynamics`, on the
-    /// configured engine).
-    pub fn from_records(
-        mass: &DesignMass,
-        dynamics: &DesignDynamics,
-        config: &StudyConfig,
-    ) -> Self {
-        let engine = config.engine.pressure_trace.is_some();
+    /// configured engine: its cycle's figures are there exactly with a pressure trace).
+    pub fn from_records(mass: &DesignMass, dynamics: &DesignDynamics) -> Self {
         FemLoads {
             force_n: dynamics.peak_pin_force_n,
-            transverse_n: if engine {
-                dynamics.peak_transverse_n
-            } else {
-                None
-            },
+            transverse_n: dynamics.peak_transverse_n,
             compression_n: dynamics
                 .peak_compression_n
                 .unwrap_or(dynamics.peak_pin_force_n),
+            engine: dynamics.peak_compression_n.is_some(),
             bore_arcs_deg: [mass.pins.crank_bore_arc_deg, mass.pins.piston_bore_arc_deg],
         }
     }
@@ -298,7 +282,7 @@ impl FemLoads {
             &config.engine,
             crate::mechanism::Method::ClosedForm,
         )?;
-        Ok(Self::from_records(&mass, &dynamics, config))
+        Ok(Self::from_records(&mass, &dynamics))
     }
 
     /// These loads with the pin force `force_n` (N) instead (`fem --force`).

@@ -78,15 +78,16 @@ pub fn fem_adaptive(
     loads: &FemLoads,
     config: &StudyConfig,
     work_dir: &Path,
-    settings: &AdaptiveMeshing,
+    adaptive: &AdaptiveMeshing,
     keep_system: bool,
     buckling_n: Option<f64>,
 ) -> Result<FemOutcome> {
     let setup = Setup::new(design, loads, config, true, keep_system)?;
     let force_n = loads.force_n;
+    let c = &config.fem;
     setup.check_uniform_size(
         design,
-        settings.initial_size_mm,
+        c.initial_size_mm,
         "first mesh of the adaptive loop (`fem.initial_size_mm`, with `fem.max_size_mm` at least as large)",
     )?;
     let mut mesher = setup.mesher(work_dir)?;
@@ -110,14 +111,13 @@ pub fn fem_adaptive(
         SMALL_FILLET_REACH_MM,
     );
     let ceiling = |p: [f64; 3]| small_fillets.ceiling_at(p.map(|v| v * 1e3)) * 1e-3;
-    let c = settings;
     let min_size_mm = if exact {
         c.step_min_size_mm
     } else {
         c.min_size_mm
     };
     let opts = AdaptOptions {
-        target_error_rel: c.target_error,
+        target_error_rel: adaptive.target_error,
         initial_size_m: c.initial_size_mm * 1e-3,
         max_size_m: c.max_size_mm * 1e-3,
         min_size_m: min_size_mm * 1e-3,
@@ -157,7 +157,7 @@ pub fn fem_adaptive(
         seconds: out.mesh_s,
         frame: FRAME.into(),
         adaptive: Some(AdaptiveSummary {
-            target_error_rel: c.target_error,
+            target_error_rel: adaptive.target_error,
             stop: out.stop,
             iterations,
             initial_size_mm: c.initial_size_mm,
