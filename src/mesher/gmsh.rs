@@ -74,7 +74,7 @@ pub struct MeshReport {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub phases_s: Option<MeshPhases>,
     /// A STEP's curved mesh: the elements made straight-sided because their scaled Jacobian was
-    /// below [`MeshPolicy::curved_sj_min`] (`mesh_rod.py`'s `straighten_poor_curved`); `None` for
+    /// below [`MeshPolicy::curved_sj_min`] (`pipeline/meshing/step.py`, `straighten_poor_curved`); `None` for
     /// an STL's mesh.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub curved_elements_straightened: Option<usize>,

@@ -240,7 +240,7 @@ pub fn read_msh_exactly(path: &Path, units: &str) -> Result<TetMesh> {
 }
 
 /// Reads a binary gmsh MSH 4.1 file that the pipeline wrote in place of an ASCII one
-/// (`pipeline/mesh_rod.py`, `written_mesh`: 0.1 s less per mesh) as the ASCII file would have
+/// (`pipeline/meshing/quality.py`, `written_mesh`: 0.1 s less per mesh) as the ASCII file would have
 /// been read: each coordinate rounded to the 16 significant digits gmsh's ASCII writer prints
 /// (`"%.16g"`), so that the mesh, and every result from it, is the ASCII file's to the last bit.
 /// (A user's binary file is read exactly, by [`read_msh_exactly`].)

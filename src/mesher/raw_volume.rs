@@ -211,7 +211,7 @@ fn name_element(path: &Path, labels: &[FileLabel], e: FemError) -> FemError {
     }
 }
 
-/// Linear tets → straight-sided tet10 exactly as `mesh_rod.py`'s `promote_tetra4` (numpy): the
+/// Linear tets → straight-sided tet10 exactly as `pipeline/meshing/rodmesh.py`'s `promote_tetra4` (numpy): the
 /// new nodes are appended in the lexicographic order of the sorted edges, at 0.5 (a + b).
 fn promote_tet4(nodes: &mut Vec<[f64; 3]>, tets: &[[usize; 4]]) -> Vec<[usize; 10]> {
     let key = |el: &[usize; 4], k: usize| {

@@ -262,7 +262,7 @@ pub struct StepTimings {
 }
 
 /// Where one gmsh mesh's time went, s (gmsh's own wall times from its log, the rest measured
-/// around the calls; `pipeline/mesh_rod.py`, `mesh_volume`). `model`: building the model before
+/// around the calls; `pipeline/meshing/volume.py`, `mesh_volume`). `model`: building the model before
 /// meshing (on the first mesh of an STL the classification of its triangles; in the loop's gmsh
 /// session the next model is built while the last mesh is solved, so later meshes show only the
 /// options set); `hxt_optimise` is part of `mesh_3d`; `read`: reading the written mesh on the

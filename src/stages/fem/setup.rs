@@ -322,7 +322,7 @@ impl Setup {
 
 /// The half model's surface: the rod-frame surface's half z ≥ c as the binary STL gmsh meshes,
 /// open at the cut (gmsh closes it with a plane surface on the cut's classified curves,
-/// `mesh_rod.py`'s `cap_open_cut`; the cap of [`crate::geometry::half_solid::half_above`] is what
+/// `pipeline/meshing/cap.py`'s `cap_open_cut`; the cap of [`crate::geometry::half_solid::half_above`] is what
 /// shows the half to be a closed solid of half the volume).
 pub(super) struct HalfSurface {
     pub(super) stl_bytes: Vec<u8>,
@@ -367,7 +367,7 @@ pub(super) fn half_surface(surface: &RodFrameSurface, symmetry: Symmetry) -> Opt
         return None;
     }
     // gmsh gets the half open at the cut and builds the cap itself, as one plane surface on the
-    // cut's classified curves (`mesh_rod.py`, `cap_open_cut`): the cap's triangles would be
+    // cut's classified curves (`pipeline/meshing/cap.py`, `cap_open_cut`): the cap's triangles would be
     // classified into patches whose cuts meet the cut's edge, where the peaks of a bending rod lie
     let open = crate::geometry::IndexedMesh {
         vertices: half.mesh.vertices.clone(),
