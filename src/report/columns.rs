@@ -264,7 +264,7 @@ pub const COLUMNS: &[Column] = &[
                     Value::Num(c.and_then(|c| c.load_models.as_ref().map(|m| m.contact_mpa)))
                 }),
                 ("cosine_von_mises_mpa", |c| {
-                    Value::Num(c.and_then(|c| c.load_models.as_ref().map(|m| m.cosine_mpa)))
+                    Value::Num(c.and_then(|c| c.load_models.as_ref().and_then(|m| m.cosine_mpa)))
                 }),
                 ("uniform_von_mises_mpa", |c| {
                     Value::Num(c.and_then(|c| c.load_models.as_ref().map(|m| m.uniform_mpa)))
@@ -280,9 +280,9 @@ pub const COLUMNS: &[Column] = &[
                     let Some(c) = c else { return dash() };
                     match (&c.load_models, c.estimated_load_model_error_rel) {
                         (Some(m), Some(e)) => format!(
-                            "{:.1} / {:.1} / {:.1}; {:.1} %; {}",
+                            "{:.1} / {} / {:.1}; {:.1} %; {}",
                             m.contact_mpa,
-                            m.cosine_mpa,
+                            m.cosine_mpa.map_or_else(dash, |v| format!("{v:.1}")),
                             m.uniform_mpa,
                             100.0 * e,
                             c.dominant_error()

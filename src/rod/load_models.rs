@@ -27,6 +27,8 @@ pub struct LoadModelSolutions {
     /// The contact solution on the whole mesh, for the report's fields (`None`: the solution
     /// compared is itself contact's).
     pub contact: Option<(TetMesh, RodSolution)>,
+    /// Why the cosine pressure could not be solved, where it could not.
+    pub cosine_error: Option<String>,
 }
 
 /// Solves the cases of `solution` (on `whole`) under the load models it was not solved under, and
@@ -62,7 +64,9 @@ pub fn compare_load_models(
             .map_err(|e| FemError::Problem(format!("the {} load model: {e}", model.name())))
     };
     let uniform = solve(BoreLoad::Uniform)?;
-    let cosine = solve(BoreLoad::Cosine)?;
+    // the cosine pressure needs the pressed half of the bore: a big end without its cap loaded
+    // across the rod has not all of it, and the comparison goes on without that model
+    let cosine = solve(BoreLoad::Cosine);
     let contact = solve(BoreLoad::Contact)?;
     let pick = |other: &Option<(TetMesh, RodSolution)>| -> Vec<LoadCaseResult> {
         other
@@ -70,7 +74,14 @@ pub fn compare_load_models(
             .map_or(&solution.result.cases.0, |(_, s)| &s.result.cases.0)
             .clone()
     };
-    let (u, c, k) = (pick(&uniform), pick(&cosine), pick(&contact));
+    let (u, k) = (pick(&uniform), pick(&contact));
+    let c: Vec<Option<f64>> = match &cosine {
+        Ok(c) => pick(c)
+            .iter()
+            .map(|c| Some(c.max_von_mises_away_from_fixed_mpa))
+            .collect(),
+        Err(_) => vec![None; u.len()],
+    };
     let peaks = u
         .iter()
         .zip(&c)
@@ -81,7 +92,7 @@ pub fn compare_load_models(
             })?;
             Ok(LoadModelPeaks {
                 uniform_mpa: u.max_von_mises_away_from_fixed_mpa,
-                cosine_mpa: c.max_von_mises_away_from_fixed_mpa,
+                cosine_mpa: *c,
                 contact_mpa: k.max_von_mises_away_from_fixed_mpa,
                 contact_at_mm: k.max_von_mises_away_from_fixed_at_mm,
                 contact_discretisation_error_rel: k.estimated_discretisation_error_rel,
@@ -89,5 +100,9 @@ pub fn compare_load_models(
             })
         })
         .collect::<Result<Vec<_>>>()?;
-    Ok(LoadModelSolutions { peaks, contact })
+    Ok(LoadModelSolutions {
+        peaks,
+        contact,
+        cosine_error: cosine.err().map(|e| e.to_string()),
+    })
 }

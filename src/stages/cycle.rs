@@ -101,7 +101,9 @@ pub fn cycle_instants(
 }
 
 /// The cycle with contact at the instants that matter ([`instants_that_matter`]) and the fatigue
-/// factor from them beside the linear cycle's at the same instants ([`contact_fatigue`]).
+/// factor from them beside the linear cycle's at the same instants ([`contact_fatigue`]); the
+/// instants that could not be solved are said (the third part), and the fatigue factor, which
+/// needs the extremes of the cycle, is then left out.
 fn contact_figures(
     mesh: &StageMesh,
     material: &Material,
@@ -109,7 +111,7 @@ fn contact_figures(
     instants: &[RodFrameInstant],
     units: &UnitSolutions,
     cycle: &CycleSolution,
-) -> crate::fem::error::Result<(Vec<ContactInstant>, ContactFatigue)> {
+) -> crate::fem::error::Result<(Vec<ContactInstant>, Option<ContactFatigue>, Option<String>)> {
     let which = instants_that_matter(instants, cycle.max_instant);
     let solved = contact_instants(
         &mesh.mesh,
@@ -120,6 +122,16 @@ fn contact_figures(
         &cycle.history,
         &which,
     )?;
+    if !solved.failed.is_empty() {
+        let why = format!(
+            "the cycle with contact: {} of {} instants not solved ({}); the fatigue factor with \
+             contact needs them all",
+            solved.failed.len(),
+            which.len(),
+            solved.failed.join("; ")
+        );
+        return Ok((solved.instants, None, Some(why)));
+    }
     let linear = which
         .iter()
         .map(|(k, _)| {
@@ -141,7 +153,7 @@ fn contact_figures(
             .map(|(k, _)| instants[*k].crank_angle_deg)
             .collect(),
     )?;
-    Ok((solved.instants, fatigue))
+    Ok((solved.instants, Some(fatigue), None))
 }
 
 /// Runs the cycle stage on stage 3's mesh (writes nothing).
@@ -160,7 +172,7 @@ pub fn cycle(mass: &DesignMass, mesh: &StageMesh, config: &StudyConfig) -> Resul
     let (contact_instants, contact_fatigue, contact_instants_error) = if config.fem.load_model_error
     {
         match contact_figures(mesh, &material, &options, &instants, &units, &cycle) {
-            Ok((v, f)) => (v, Some(f), None),
+            Ok((v, f, failed)) => (v, f, failed),
             Err(e) => (Vec::new(), None, Some(format!("{e}"))),
         }
     } else {

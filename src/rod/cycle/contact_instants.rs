@@ -29,7 +29,7 @@ use crate::fem::mesh::TetMesh;
 use crate::fem::mesh::mirror::mirror;
 use crate::fem::stress::{peak_nodal, stress_field};
 use crate::mechanism::RodFrameInstant;
-use crate::rod::bores::{BoreSpec, find_bores};
+use crate::rod::bores::{BoreSpec, BoreSurface, find_bores};
 use crate::rod::contact_cases::{clearances_m, pin_in};
 use crate::rod::fatigue::signed_von_mises;
 use crate::rod::half_model::mirror_plane_tolerance;
@@ -67,6 +67,8 @@ pub struct ContactInstant {
 pub struct ContactInstants {
     pub instants: Vec<ContactInstant>,
     pub signed_von_mises_pa: Vec<Vec<f64>>,
+    /// The instants that could not be solved, each with why (the others are solved).
+    pub failed: Vec<String>,
 }
 
 /// Instants of the cycle closer than this (degrees of crank angle, across the cycle's end too) are
@@ -145,6 +147,7 @@ pub fn contact_instants(
         return Ok(ContactInstants {
             instants: Vec::new(),
             signed_von_mises_pa: Vec::new(),
+            failed: Vec::new(),
         });
     }
     // the mesh solved: the half model with its plane held, or the whole
@@ -227,15 +230,17 @@ pub fn contact_instants(
         })
     };
     let system = ContactSystem::new(&problem_at(instant(which[0].0)?)?)?;
-    let solved: Vec<(ContactInstant, Vec<f64>)> = which
+    let open_side = open_side_of(&loaded, axis, bores.loaded_arc_deg, solved);
+    let solved: Vec<Result<(ContactInstant, Vec<f64>)>> = which
         .iter()
         .map(|(k, reason)| {
             let inst = instant(*k)?;
             let problem = problem_at(inst)?;
             let s = system.solve(&problem).map_err(|e| {
                 FemError::Problem(format!(
-                    "the cycle with contact at φ = {:.0}° ({reason}): {e}",
-                    inst.crank_angle_deg
+                    "φ = {:.0}° ({reason}): {e}{}",
+                    inst.crank_angle_deg,
+                    open_side(inst.f_a_on_rod_n)
                 ))
             })?;
             let u = match &half {
@@ -271,10 +276,59 @@ pub fn contact_instants(
             };
             Ok((record, signed))
         })
-        .collect::<Result<_>>()?;
-    let (instants, signed_von_mises_pa) = solved.into_iter().unzip();
-    Ok(ContactInstants {
-        instants,
-        signed_von_mises_pa,
-    })
+        .collect();
+    let mut out = ContactInstants {
+        instants: Vec::new(),
+        signed_von_mises_pa: Vec::new(),
+        failed: Vec::new(),
+    };
+    for r in solved {
+        match r {
+            Ok((record, signed)) => {
+                out.instants.push(record);
+                out.signed_von_mises_pa.push(signed);
+            }
+            Err(e) => out.failed.push(e.to_string()),
+        }
+    }
+    Ok(out)
+}
+
+/// For a partial bore A (`arc_deg` < 360: a big end without its cap), what to add to a failed
+/// instant's message: how far the pin force points from the middle of the arc that exists (the
+/// mean direction of the wall's nodes from the axis), beside the arc's half width; empty for a
+/// full bore.
+fn open_side_of<'a>(
+    bore: &'a BoreSurface,
+    axis: [f64; 3],
+    arc_deg: f64,
+    mesh: &'a TetMesh,
+) -> impl Fn([f64; 2]) -> String + 'a {
+    let mut middle = [0.0; 3];
+    for &n in &bore.nodes {
+        let x = mesh.nodes()[n];
+        let d: [f64; 3] = std::array::from_fn(|j| x[j] - bore.centre_m[j]);
+        let along = (0..3).map(|j| d[j] * axis[j]).sum::<f64>();
+        let r: [f64; 3] = std::array::from_fn(|j| d[j] - along * axis[j]);
+        let l = norm(r).max(f64::MIN_POSITIVE);
+        for j in 0..3 {
+            middle[j] += r[j] / l;
+        }
+    }
+    move |f: [f64; 2]| {
+        let (lf, lm) = (f[0].hypot(f[1]), norm(middle));
+        if arc_deg >= 360.0 || lf == 0.0 || lm == 0.0 {
+            return String::new();
+        }
+        let cos = (f[0] * middle[0] + f[1] * middle[1]) / (lf * lm);
+        format!(
+            "; bore A is a partial bore of {arc_deg:.0}° (a big end without its cap) and the pin \
+             force ({:.0}, {:.0}) N points {:.0}° from the middle of its arc (which reaches \
+             ±{:.0}°): a force towards the open side needs the cap",
+            f[0],
+            f[1],
+            cos.clamp(-1.0, 1.0).acos().to_degrees(),
+            arc_deg / 2.0
+        )
+    }
 }

@@ -203,6 +203,11 @@ fn add_load_model_error(
     let centre_distance_mm = 1e3 * (0..3).map(|j| (b[j] - a[j]).powi(2)).sum::<f64>().sqrt();
     outcome.record.criterion = verdict(&outcome.record.fem, config, centre_distance_mm);
     outcome.contact = compared.contact;
+    if let Some(e) = compared.cosine_error {
+        let w = format!("the load-model comparison has no cosine pressure: {e}");
+        outcome.record.fem.warnings.push(w.clone());
+        outcome.solution.result.warnings.push(w);
+    }
     Ok(())
 }
 
