@@ -21,6 +21,13 @@ use nalgebra::Vector3;
 /// Number of in-plane ray directions (every 30°).
 pub const IN_PLANE_RAYS: usize = 12;
 
+/// [`BoreProbe::on_the_axis`]: the largest angle, degrees, between an in-plane ray and the normal
+/// of the facet it meets (in the plane across the axis).
+pub const FACING_DEG: f64 = 3.0;
+
+/// [`BoreProbe::on_the_axis`]: the largest spread of the in-plane hit distances, relative.
+pub const RANGE_REL: f64 = 0.01;
+
 /// The rod's surface for the bore queries.
 pub struct RodSurface<'a> {
     mesh: &'a IndexedMesh,
@@ -88,6 +95,19 @@ impl<'a> RodSurface<'a> {
         scale: f64,
         units: &str,
     ) -> Result<f64> {
+        self.bore_radius_probed(pin, centre, axis, scale, units)
+            .map(|(r, _)| r)
+    }
+
+    /// [`RodSurface::bore_radius`] with the rays' record ([`BoreProbe`]).
+    pub fn bore_radius_probed(
+        &self,
+        pin: &str,
+        centre: Vector3<f64>,
+        axis: Vector3<f64>,
+        scale: f64,
+        units: &str,
+    ) -> Result<(f64, BoreProbe)> {
         let hint = "check the STL units (sidecar `units`, default mm) and the pin centres (sidecar `crank_pin`, `piston_pin`)";
         let at = shown(centre, scale, units);
         let probe = self.probe(centre, axis);
@@ -101,7 +121,7 @@ impl<'a> RodSurface<'a> {
                 ),
             }
         }
-        Ok(radius)
+        Ok((radius, probe))
     }
 
     /// Checks that `centre` lies on the axis of a partial bore (an arc open on one side, e.g. a
@@ -184,17 +204,32 @@ impl<'a> RodSurface<'a> {
             .filter(|[a, b]| hits((axis + u * *a + v * *b).normalize(), &on_axis).len() % 2 == 1)
             .count();
         let along_axis = [axis, -axis].map(|dir| hits(dir, &on_axis).into_iter().reduce(f64::min));
-        let in_plane = (0..IN_PLANE_RAYS)
+        let (in_plane, in_plane_normals) = (0..IN_PLANE_RAYS)
             .map(|k| {
                 let angle = std::f64::consts::TAU * k as f64 / IN_PLANE_RAYS as f64;
                 let dir = u * angle.cos() + v * angle.sin();
-                hits(dir, &across_plane).into_iter().reduce(f64::min)
+                let first = across_plane
+                    .iter()
+                    .filter_map(|&t| ray_triangle(centre, dir, t).map(|d| (d, t)))
+                    .min_by(|a, b| a.0.total_cmp(&b.0));
+                match first {
+                    Some((d, [a, b, c])) => (Some(d), (b - a).cross(&(c - a)).try_normalize(0.0)),
+                    None => (None, None),
+                }
             })
-            .collect();
+            .unzip();
         BoreProbe {
             inside: odd >= 2,
             along_axis,
             in_plane,
+            in_plane_normals,
+            axis,
+            directions: (0..IN_PLANE_RAYS)
+                .map(|k| {
+                    let angle = std::f64::consts::TAU * k as f64 / IN_PLANE_RAYS as f64;
+                    u * angle.cos() + v * angle.sin()
+                })
+                .collect(),
         }
     }
 }
@@ -246,9 +281,47 @@ pub struct BoreProbe {
     pub along_axis: [Option<f64>; 2],
     /// The nearest hit in each of the [`IN_PLANE_RAYS`] directions across the axis.
     pub in_plane: Vec<Option<f64>>,
+    /// The unit normal of the triangle each in-plane ray meets first.
+    pub in_plane_normals: Vec<Option<Vector3<f64>>>,
+    /// The pin axis (unit) and the in-plane rays' directions.
+    pub axis: Vector3<f64>,
+    pub directions: Vec<Vector3<f64>>,
 }
 
 impl BoreProbe {
+    /// Whether the rays show the centre on the axis of a round bore parallel to the pin axis,
+    /// to within half the sidecar check's tolerances (1 % of the radius off the axis, 1° of tilt),
+    /// without fitting the bore: every ray meets a facet within [`FACING_DEG`] of facing it
+    /// square (so the faceting changes a hit distance by at most 1 − cos 3° = 0.14 % of the
+    /// radius), the hit distances t_k agree within [`RANGE_REL`] (an offset e makes them
+    /// t_k ≈ r − e cos(θ_k − φ): a range of at least 2e cos 15° for 12 rays, so
+    /// e ≤ (1 % + 0.14 %) r / 1.93 = 0.59 % r), and no hit facet's normal has a component along
+    /// the pin axis above sin 0.5° (a wall tilted by τ has one of sin τ cos(θ_k − φ), at least
+    /// sin τ cos 15°: τ < 0.52°). `false` decides nothing: the bores are then fitted.
+    pub fn on_the_axis(&self) -> bool {
+        let hits: Option<Vec<(f64, Vector3<f64>, Vector3<f64>)>> = self
+            .in_plane
+            .iter()
+            .zip(&self.in_plane_normals)
+            .zip(&self.directions)
+            .map(|((t, n), d)| Some(((*t)?, (*n)?, *d)))
+            .collect();
+        let Some(hits) = hits.filter(|h| !h.is_empty()) else {
+            return false;
+        };
+        let (lo, hi) = hits.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), h| {
+            (lo.min(h.0), hi.max(h.0))
+        });
+        let square = FACING_DEG.to_radians().cos();
+        let tilt = 0.5f64.to_radians().sin();
+        hi - lo <= RANGE_REL * lo
+            && hits.iter().all(|(_, n, d)| {
+                let along = n.dot(&self.axis);
+                let in_plane = (n - self.axis * along).norm();
+                along.abs() <= tilt && in_plane > 0.0 && n.dot(d).abs() / in_plane >= square
+            })
+    }
+
     /// Refuses a centre in material or with material along its axis (the messages of
     /// [`RodSurface::bore_radius`]).
     fn axis_clear(&self, pin: &str, at: &str, scale: f64, units: &str, hint: &str) -> Result<()> {
@@ -325,5 +398,35 @@ mod tests {
                 .to_string()
                 .contains("hits material after 15.000 mm")
         );
+    }
+
+    /// The rays decide "on the axis" only well inside the sidecar check's tolerances (1 % of the
+    /// radius, 1°): on a 96-facet tube (facets 1.9° either side of square) a centred pin, 0.3 %
+    /// off and a pin axis 0.3° off pass; 0.6 % off (a spread of 1.2 %), a pin axis 0.6° off and
+    /// a 24-facet bore (facets 7.5° either side) are left to the fitted bores.
+    #[test]
+    fn the_rays_show_a_pin_on_the_axis_only_well_within_the_tolerances() {
+        let tube = hollow_cylinder(30.0, 12.5, 40.0, 96);
+        let s = RodSurface::new(&tube).unwrap();
+        let z = Vector3::z();
+        let at = |x: f64, axis: Vector3<f64>| {
+            s.bore_radius_probed("pin", Vector3::new(x, 0.0, 0.0), axis, 1.0, "mm")
+                .unwrap()
+                .1
+                .on_the_axis()
+        };
+        assert!(at(0.0, z));
+        assert!(at(0.003 * 12.5, z));
+        assert!(!at(0.006 * 12.5, z));
+        let tilted = |deg: f64| Vector3::new(deg.to_radians().sin(), 0.0, deg.to_radians().cos());
+        assert!(at(0.0, tilted(0.3)));
+        assert!(!at(0.0, tilted(0.6)));
+        let coarse = hollow_cylinder(30.0, 12.5, 40.0, 24);
+        let s = RodSurface::new(&coarse).unwrap();
+        let probe = s
+            .bore_radius_probed("pin", Vector3::zeros(), z, 1.0, "mm")
+            .unwrap()
+            .1;
+        assert!(!probe.on_the_axis());
     }
 }

@@ -91,9 +91,11 @@ pub(super) fn pin_bore(
     {
         return partial(bore, warnings);
     }
-    match surface.bore_radius(name, centre, axis, scale, units) {
-        Ok(radius) => {
-            if d.from_sidecar {
+    match surface.bore_radius_probed(name, centre, axis, scale, units) {
+        Ok((radius, probe)) => {
+            // the bores are fitted only where the rays do not show the pin on a round bore's
+            // axis well within the check's tolerances
+            if d.from_sidecar && !probe.on_the_axis() {
                 let near = bores_around_the_pin(d.mesh, centre, axis, radius);
                 pin_on_the_bores_axis(d, &near, name, centre, axis, warnings)?;
             }
