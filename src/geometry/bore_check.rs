@@ -299,7 +299,9 @@ impl BoreProbe {
     /// the pin axis above sin 0.5° (a wall tilted by τ has one of sin τ cos(θ_k − φ), at least
     /// sin τ cos 15°: τ < 0.52°). `false` decides nothing: the bores are then fitted.
     pub fn on_the_axis(&self) -> bool {
-        let hits: Option<Vec<(f64, Vector3<f64>, Vector3<f64>)>> = self
+        // per ray: (hit distance, facet normal, ray direction)
+        type Hit = (f64, Vector3<f64>, Vector3<f64>);
+        let hits: Option<Vec<Hit>> = self
             .in_plane
             .iter()
             .zip(&self.in_plane_normals)
