@@ -43,6 +43,18 @@ fn plate(thickness: f64, n_z: usize) -> (TwoEyePlate, TetMesh) {
     (p, mesh)
 }
 
+/// The half z ≥ 0 of a plate `t` thick: a plate of half the thickness moved up by a quarter (its
+/// mirror is the whole).
+fn half_plate(t: f64) -> (TwoEyePlate, TetMesh) {
+    let (p, h) = plate(t / 2.0, 2);
+    let nodes: Vec<[f64; 3]> = h
+        .nodes()
+        .iter()
+        .map(|x| [x[0], x[1], x[2] + t / 4.0])
+        .collect();
+    (p, TetMesh::new(nodes, h.elements().to_vec()).unwrap())
+}
+
 fn contact_spec(p: &TwoEyePlate) -> BoreSpec {
     BoreSpec {
         fixed_centre_m: [p.length, 0.0, 0.0],
@@ -98,15 +110,7 @@ fn the_contact_load_case_is_the_direct_contact_solve_and_balances() {
 
 #[test]
 fn a_half_model_under_contact_is_the_whole_plate() {
-    let t = 0.04;
-    // the half z ≥ 0: a plate of half the thickness moved up by a quarter; the whole, its mirror
-    let (p, h) = plate(t / 2.0, 2);
-    let nodes: Vec<[f64; 3]> = h
-        .nodes()
-        .iter()
-        .map(|x| [x[0], x[1], x[2] + t / 4.0])
-        .collect();
-    let half = TetMesh::new(nodes, h.elements().to_vec()).unwrap();
+    let (p, half) = half_plate(0.04);
     let whole = mirror(&half, 0.0, 1e-9).unwrap().whole;
     let spec = contact_spec(&p);
     let w = solve_rod_fields(
@@ -135,14 +139,7 @@ fn a_half_model_under_contact_is_the_whole_plate() {
 
 #[test]
 fn the_cycles_contact_instants_on_a_half_model_are_the_wholes() {
-    let t = 0.04;
-    let (p, h) = plate(t / 2.0, 2);
-    let nodes: Vec<[f64; 3]> = h
-        .nodes()
-        .iter()
-        .map(|x| [x[0], x[1], x[2] + t / 4.0])
-        .collect();
-    let half = TetMesh::new(nodes, h.elements().to_vec()).unwrap();
+    let (p, half) = half_plate(0.04);
     let m = mirror(&half, 0.0, 1e-9).unwrap();
     let spec = contact_spec(&p);
     // three instants with inertia along the rod, each in balance (the plate is symmetric about

@@ -124,6 +124,20 @@ pub enum BenchCommand {
     },
 }
 
+/// The settings file's configuration (the spec's defaults without one) and stage 3's mesh mode:
+/// one fixed mesh of `size` mm, else the configuration's.
+fn config_and_mode(
+    config: Option<&std::path::Path>,
+    size: Option<f64>,
+) -> Result<(crate::config::StudyConfig, crate::stages::fem::MeshMode)> {
+    let config = crate::config::StudyConfig::load(config)?;
+    let mode = match size {
+        Some(h) => crate::stages::fem::MeshMode::Fixed(h),
+        None => crate::stages::fem::MeshMode::from_config(&config),
+    };
+    Ok((config, mode))
+}
+
 pub fn run(command: BenchCommand) -> Result<i32> {
     match command {
         BenchCommand::Mass {
@@ -214,11 +228,7 @@ pub fn run(command: BenchCommand) -> Result<i32> {
             config,
             json,
         } => {
-            let config = crate::config::StudyConfig::load(config.as_deref())?;
-            let mode = match size {
-                Some(h) => crate::stages::fem::MeshMode::Fixed(h),
-                None => crate::stages::fem::MeshMode::from_config(&config),
-            };
+            let (config, mode) = config_and_mode(config.as_deref(), size)?;
             let b = crate::bench::load_models::bench_load_models(&design, &config, &mode, repeats)?;
             if json {
                 outln!("{}", serde_json::to_string_pretty(&b)?);
@@ -261,11 +271,7 @@ pub fn run(command: BenchCommand) -> Result<i32> {
             config,
             json,
         } => {
-            let config = crate::config::StudyConfig::load(config.as_deref())?;
-            let mode = match size {
-                Some(h) => crate::stages::fem::MeshMode::Fixed(h),
-                None => crate::stages::fem::MeshMode::from_config(&config),
-            };
+            let (config, mode) = config_and_mode(config.as_deref(), size)?;
             let b = crate::bench::contact_cycle::bench_contact_cycle(
                 &design, &config, &mode, instants,
             )?;

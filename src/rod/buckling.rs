@@ -38,9 +38,18 @@ pub fn rod_buckling(
         load: case.load,
         quadrature,
     };
+    solve_on(&problem, options, system)
+}
+
+/// The buckling problem on the factorised `system` when given, else factorised here.
+fn solve_on(
+    problem: &BucklingProblem,
+    options: &BucklingOptions,
+    system: Option<&FactorisedSystem>,
+) -> Result<BucklingSolution> {
     match system {
-        Some(system) => solve_buckling_with(&problem, system, options),
-        None => solve_buckling(&problem, options),
+        Some(system) => solve_buckling_with(problem, system, options),
+        None => solve_buckling(problem, options),
     }
 }
 
@@ -83,10 +92,7 @@ pub fn rod_buckling_contact(
         load: contact.contact_forces[0].clone(),
         quadrature,
     };
-    match system {
-        Some(system) => solve_buckling_with(&problem, system, options),
-        None => solve_buckling(&problem, options),
-    }
+    solve_on(&problem, options, system)
 }
 
 #[cfg(test)]
