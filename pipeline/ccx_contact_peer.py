@@ -34,7 +34,8 @@ CSTR and CF). Printed: the peak von Mises away from both bores (nodes farther th
 both walls; with --judged FILE, a 0/1 per node, also over those nodes), per bore the peak nodal,
 smoothed (as rodstudy smooths its own) and integration-point contact pressure, the resultant of
 the nodal pressure, the contact arc (360 degrees - the largest angular gap
-between wall nodes with CPRESS > 0), the contact area and forces, an element's angular size, the pins'
+between wall nodes with CPRESS > 0), the element at each end of the arc (the angular span of the
+outermost wall face with an integration point in contact: the arc ends inside it), the contact area and forces, an element's angular size, the pins'
 reactions and pin A's travel.
 
 ccx measures the gap between the quadratic wall faces and the pin: the walls must be curved
@@ -303,6 +304,24 @@ def arc(angles_deg: np.ndarray):
     return 360.0 - gaps[i], ends
 
 
+def arc_end_elements(wall, keys, ip, pts, centre, direction_deg):
+    """The angular span (degrees from `direction_deg`) of the outermost wall face on each side
+    of the arc (negative, positive) with an integration point in contact: ccx's arc ends inside
+    these faces. `wall`: the faces' node lists; `keys`: their (element, face) in ccx's numbering;
+    `ip`: (element, face) -> integration-point pressures."""
+    spans = []
+    for f, key in zip(wall, keys):
+        if max(ip.get(key, [0.0])) <= 0.0:
+            continue
+        c = pts[f[:3]]
+        th = np.degrees(np.arctan2(c[:, 1] - centre[1], c[:, 0] - centre[0]))
+        th = (th - direction_deg + 180.0) % 360.0 - 180.0
+        spans.append((float(th.min()), float(th.max())))
+    if not spans:
+        return None
+    return [list(min(spans)), list(max(spans, key=lambda s: s[1]))]
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("mesh", help=".rodmesh file (the mesh rodstudy solved)")
@@ -417,6 +436,8 @@ def main(argv=None) -> int:
         direction = np.degrees(np.arctan2(0.0, 1.0 if name == "a" else -1.0))
         ang = (i["theta"] - direction + 180.0) % 360.0 - 180.0
         extent, ends = arc(ang[active])
+        keys = [(int(e) + 1, int(f)) for e, f in zip(*walls[k])]
+        end_elements = arc_end_elements(i["wall"], keys, ip, pts, centre, direction)
         smooth, resultant = smoothed_pressure(pts, i["wall"], centre, {int(v): q for v, q in zip(nodes, cp)})
         sp = np.array([smooth[int(v)] for v in nodes])
         figures[f"bore_{name}"] = {
@@ -427,6 +448,7 @@ def main(argv=None) -> int:
             "peak_smoothed_angle_deg": float(ang[int(np.argmax(sp))]),
             "cpress_resultant_n": resultant.tolist(),
             "active_nodes": int(active.sum()), "arc_deg": float(extent), "arc_ends_deg": list(ends),
+            "arc_end_elements_deg": end_elements,
             "max_penetration_mm": float(max(0.0, -copen[active].min()) if active.any() else 0.0),
             "contact_area_mm2": stats[k]["area_mm2"] if k < len(stats) else None,
             "normal_force_n": stats[k]["normal_force_n"] if k < len(stats) else None,
