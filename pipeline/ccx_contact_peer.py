@@ -14,9 +14,11 @@ order) and builds the contact model independently, with numpy (units mm, N, MPa)
   * each pin a tube of 20-node bricks (C3D20, every node on its circle) whose outer faces are the
     master surface: radius r - c (r the bore radius found, c the radial clearance; c < 0 an
     interference), one brick per node pitch of the wall around (--pin-facets), 4 along the axis
-    (--pin-layers), reaching 1 mm past the wall at both ends. The pins are rigid: pin B's nodes
-    fixed; pin A's nodes translate along x as one (*EQUATION on every node's x to its first node,
-    which carries the force F along +x as *CLOAD), y and z fixed;
+    (--pin-layers), reaching 1 mm past the wall at both ends (--pin-overhang). The pins are rigid:
+    pin B's nodes fixed; pin A's nodes translate along x as one (*EQUATION on every node's x to
+    its first node, which carries the force F along +x as *CLOAD), y and z fixed. With
+    --elastic-pins ends|core the pins are steel and only their end faces or their inner surface
+    are held so (the pin's wall: --pin-inner, --pin-radial);
   * frictionless face-to-face penalty contact (*CONTACT PAIR, TYPE=SURFACE TO SURFACE, no
     *FRICTION), PRESSURE-OVERCLOSURE=LINEAR with slope K (N/mm^3, default 100 E / h, h the mean
     edge of the walls) and no tension;
@@ -114,29 +116,37 @@ BRICK20 = [(-1, -1, -1), (1, -1, -1), (1, 1, -1), (-1, 1, -1), (-1, -1, 1), (1, 
            (-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)]
 
 
-def pin_mesh(centre, rho, z0, z1, n_theta, nz, first_node):
-    """The rigid pin of a bore: a tube of 20-node bricks (C3D20) of outer radius rho, inner 0.8 rho,
-    n_theta around, nz along the axis from z0 to z1, every node on its circle, so that the outer
+def pin_mesh(centre, rho, z0, z1, n_theta, nz, first_node, inner=0.8, n_radial=1):
+    """The pin of a bore: a tube of 20-node bricks (C3D20) of outer radius rho, inner `inner` rho,
+    n_theta around, n_radial through the wall, nz along the axis from z0 to z1, every node on its
+    circle, so that the outer
     faces (face S4 of each brick, the master surface) are quadratic arcs: 0.9 nm off the cylinder
     at rho = 25 mm and 3.75 degree bricks (computed), where flat facets of that size would be off
     by their sagitta, 13 um.
-    Returns (nodes (n, 3), bricks (m, 20) global 0-based ids)."""
+    Returns (nodes (n, 3), bricks (m, 20) global 0-based ids, the outer bricks' indices, the
+    global ids of the nodes where an elastic pin is held: {"ends": on the end faces z0 and z1,
+    "core": on the inner surface}); the first node is on both."""
     ids, nodes, bricks = {}, [], []
 
-    def node(i2, j2, k2):  # on the doubled grid: around, radius (0, 1, 2), along the axis
+    def node(i2, j2, k2):  # on the doubled grid: around, radius (0 .. 2 n_radial), along the axis
         key = (i2 % (2 * n_theta), j2, k2)
         if key not in ids:
             t = np.pi * key[0] / n_theta
-            rr = 0.8 * rho + 0.1 * rho * j2
+            rr = rho * (inner + (1.0 - inner) * j2 / (2 * n_radial))
             ids[key] = first_node + len(nodes)
             nodes.append([centre[0] + rr * np.cos(t), centre[1] + rr * np.sin(t), z0 + (z1 - z0) * k2 / (2 * nz)])
         return ids[key]
 
     for k in range(nz):
-        for i in range(n_theta):
-            # (xi, eta, zeta) = (radial, around, axial), right-handed: the outer face xi = +1 is S4
-            bricks.append([node(2 * i + 1 + e, 1 + x, 2 * k + 1 + z) for x, e, z in BRICK20])
-    return np.array(nodes), np.array(bricks, dtype=np.int64)
+        for j in range(n_radial):
+            for i in range(n_theta):
+                # (xi, eta, zeta) = (radial, around, axial), right-handed: the outer face xi = +1
+                # is S4
+                bricks.append([node(2 * i + 1 + e, 2 * j + 1 + x, 2 * k + 1 + z) for x, e, z in BRICK20])
+    outer = [b for b in range(len(bricks)) if (b // n_theta) % n_radial == n_radial - 1]
+    held = {"ends": sorted(v for key, v in ids.items() if key[2] in (0, 2 * nz)),
+            "core": sorted(v for key, v in ids.items() if key[1] == 0)}
+    return np.array(nodes), np.array(bricks, dtype=np.int64), outer, held
 
 
 def lines_of(ids, per=12):
@@ -144,8 +154,12 @@ def lines_of(ids, per=12):
     return [", ".join(s[i:i + per]) for i in range(0, len(s), per)]
 
 
-def write_deck(path, pts, tets, walls, pins, force, slope, rod_z_node):
-    """walls: [(elements, sides)] per bore; pins: [(nodes, bricks, clearance)] (A first)."""
+def write_deck(path, pts, tets, walls, pins, force, slope, rod_z_node, hold=None):
+    """walls: [(elements, sides)] per bore; pins: [(nodes, bricks, outer bricks, held nodes)]
+    (A first). Rigid pins (hold None): pin B's nodes fixed, pin A's nodes tied along x to its
+    first node, which carries the force, y and z fixed. Elastic pins: the same on the held nodes
+    only (hold "ends": the pins' two end faces, a pin held at its ends as in a piston's bosses or
+    a crank's webs; "core": the inner surface, a pin with a rigid core), the rest deforms."""
     n_rod = len(pts)
     out = ["*HEADING", "rodstudy CalculiX contact peer (mm, N, MPa)", "*NODE"]
     allpts = np.concatenate([pts] + [p[0] for p in pins])
@@ -153,7 +167,7 @@ def write_deck(path, pts, tets, walls, pins, force, slope, rod_z_node):
     out.append("*ELEMENT, TYPE=C3D10, ELSET=ROD")
     out += [f"{e + 1}, " + ", ".join(str(v + 1) for v in row) for e, row in enumerate(tets.tolist())]
     first = len(tets)
-    for k, (nodes, bricks, _) in enumerate(pins):
+    for k, (nodes, bricks, _, _) in enumerate(pins):
         out.append(f"*ELEMENT, TYPE=C3D20, ELSET=PIN{k}")
         for e, row in enumerate(bricks.tolist()):
             # at most 16 entries a line, a trailing comma continues it
@@ -161,19 +175,21 @@ def write_deck(path, pts, tets, walls, pins, force, slope, rod_z_node):
             out.append(", ".join(str(v + 1) for v in row[15:]))
         first += len(bricks)
     starts = [n_rod]
-    for nodes, _, _ in pins:
+    for nodes, _, _, _ in pins:
         starts.append(starts[-1] + len(nodes))
+    held = [[v + 1 for v in sets[hold]] if hold else list(range(starts[k] + 1, starts[k + 1] + 1))
+            for k, (_, _, _, sets) in enumerate(pins)]
     for k in range(len(pins)):
         out.append(f"*NSET, NSET=NPIN{k}")
-        out += lines_of(range(starts[k] + 1, starts[k + 1] + 1))
+        out += lines_of(held[k])
     out.append("*NSET, NSET=NPINAREF")
     out.append(str(starts[0] + 1))
     first = len(tets)
-    for k, ((elems, sides), (nodes, bricks, clearance)) in enumerate(zip(walls, pins)):
+    for k, ((elems, sides), (nodes, bricks, outer, _)) in enumerate(zip(walls, pins)):
         out.append(f"*SURFACE, NAME=WALL{k}, TYPE=ELEMENT")
         out += [f"{e + 1}, S{s}" for e, s in zip(elems.tolist(), sides.tolist())]
         out.append(f"*SURFACE, NAME=PIN{k}, TYPE=ELEMENT")
-        out += [f"{first + e + 1}, S4" for e in range(len(bricks))]
+        out += [f"{first + e + 1}, S4" for e in outer]
         first += len(bricks)
     out += ["*MATERIAL, NAME=STEEL", "*ELASTIC", f"{E_MPA:.13g}, {NU:.13g}",
             "*SOLID SECTION, ELSET=ROD, MATERIAL=STEEL"]
@@ -181,13 +197,13 @@ def write_deck(path, pts, tets, walls, pins, force, slope, rod_z_node):
         out.append(f"*SOLID SECTION, ELSET=PIN{k}, MATERIAL=STEEL")
     out += ["*SURFACE INTERACTION, NAME=FRICTIONLESS",
             "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR", f"{slope:.13g}, 0.0"]
-    for k, (_, _, clearance) in enumerate(pins):
+    for k in range(len(pins)):
         out += ["*CONTACT PAIR, INTERACTION=FRICTIONLESS, TYPE=SURFACE TO SURFACE",
                 f"WALL{k}, PIN{k}"]
-    # pin A: every node's x equal to its first node's
+    # pin A: every held node's x equal to its first node's
     out.append("*EQUATION")
-    for n in range(starts[0] + 1, starts[1]):
-        out += ["2", f"{n + 1}, 1, 1.0, {starts[0] + 1}, 1, -1.0"]
+    for n in held[0][1:]:
+        out += ["2", f"{n}, 1, 1.0, {starts[0] + 1}, 1, -1.0"]
     out += ["*BOUNDARY", "NPIN0, 2, 3", "NPIN1, 1, 3", f"{rod_z_node + 1}, 3, 3",
             "*STEP", "*STATIC", "1.0, 1.0",
             "*CLOAD", f"{starts[0] + 1}, 1, {force:.13g}",
@@ -332,6 +348,14 @@ def main(argv=None) -> int:
     ap.add_argument("--pin-facets", type=int,
                     help="the pin's facets around (default: one per node pitch of the wall)")
     ap.add_argument("--pin-layers", type=int, default=4, help="the pin's bricks along its axis (default 4)")
+    ap.add_argument("--elastic-pins", choices=["ends", "core"],
+                    help="steel pins held only at their end faces (ends) or their inner surface (core) "
+                         "instead of rigid pins")
+    ap.add_argument("--pin-inner", type=float, default=0.8,
+                    help="the pin's inner radius over its outer radius (default 0.8; a hollow piston pin 0.5-0.6)")
+    ap.add_argument("--pin-radial", type=int, default=1, help="the pin's bricks through its wall (default 1)")
+    ap.add_argument("--pin-overhang", type=float, default=1.0,
+                    help="how far the pin reaches beyond the bore's faces on each side, mm (default 1)")
     ap.add_argument("--band", type=float, default=3.0,
                     help="nodes within this distance of a bore wall (mm) are left out of the peak von Mises")
     ap.add_argument("--judged", help="a 0/1 per node: the nodes of a second peak von Mises")
@@ -366,10 +390,12 @@ def main(argv=None) -> int:
         element_deg = float(np.degrees(np.ptp(np.unwrap(tc, axis=1), axis=1).mean()))
         # facets per node pitch (half an element) around
         n_theta = args.pin_facets if args.pin_facets else int(round(2 * 360.0 / element_deg))
-        pn, pb = pin_mesh(centre, r - clearance, z.min() - 1.0, z.max() + 1.0, n_theta, args.pin_layers, node0)
+        pn, pb, outer, held = pin_mesh(centre, r - clearance, z.min() - args.pin_overhang,
+                                       z.max() + args.pin_overhang, n_theta, args.pin_layers, node0,
+                                       inner=args.pin_inner, n_radial=args.pin_radial)
         node0 += len(pn)
         walls.append((felem[sel], fside[sel]))
-        pins.append((pn, pb, clearance))
+        pins.append((pn, pb, outer, held))
         info.append({"radius_mm": float(r), "faces": int(sel.sum()), "nodes": nodes, "theta": th, "wall": wf,
                      "edge_mm": float(h), "element_deg": element_deg, "pin_facets": n_theta})
     h_wall = np.mean([i["edge_mm"] for i in info])
@@ -382,7 +408,8 @@ def main(argv=None) -> int:
     frd = work / "rod.frd"
     reuse = args.reuse and frd.exists()
     if not reuse:
-        write_deck(work / "rod.inp", pts, tets, walls, pins, args.force, slope, rod_z_node)
+        write_deck(work / "rod.inp", pts, tets, walls, pins, args.force, slope, rod_z_node,
+                   hold=args.elastic_pins)
     env = dict(os.environ)
     env.setdefault("OMP_NUM_THREADS", "2")
     env.setdefault("CCX_NPROC_EQUATION_SOLVER", env["OMP_NUM_THREADS"])

@@ -57,7 +57,7 @@ fn peak_away_from_bores(mesh: &rodstudy::fem::TetMesh, c: &RodContact, band_m: f
 }
 
 /// `ccx_contact_peer.py --json` on `mesh` (its default penalty slope, 100 E / h); the deck and
-/// results stay in `$RODSTUDY_CCX_WORKDIR` when it is set.
+/// results stay in `$RODSTUDY_CCX_WORKDIR` when it is set, beside the mesh (`plate.rodmesh`).
 fn ccx(mesh: &Path) -> serde_json::Value {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let py = rodstudy::python_env::python().expect("the pipeline's Python environment");
@@ -69,6 +69,8 @@ fn ccx(mesh: &Path) -> serde_json::Value {
         .args(["--clearance-b", &(CLEARANCE_M * 1e3).to_string()])
         .args(["--band", &BAND_MM.to_string()]);
     if let Some(dir) = std::env::var_os("RODSTUDY_CCX_WORKDIR") {
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::copy(mesh, Path::new(&dir).join("plate.rodmesh")).unwrap();
         cmd.arg("--workdir").arg(dir);
     }
     let out =
