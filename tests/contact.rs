@@ -1,12 +1,13 @@
 //! Frictionless contact of a tet10 body on rigid pins (`rodstudy::fem::contact`), each test
 //! against an independent reference: Lamé's thick cylinder (a pressed pin), the Fourier
 //! (Michell) series solution of a rigid pin with clearance in a large plate (a second method),
-//! the equilibrium of a body held by two pins, and a fresh solve for a factorised system reused.
+//! the equilibrium of a body held by two pins, a fresh solve for a factorised system reused, and
+//! elastic pins against the rigid pin they tend to as their modulus grows.
 
 use rodstudy::fem::boundary::boundary_faces;
 use rodstudy::fem::contact::{
-    ContactProblem, ContactSolution, ContactSystem, ContactTolerances, Cylinder, PinMotion, check,
-    diameter_change, solve_contact,
+    ContactProblem, ContactSolution, ContactSystem, ContactTolerances, Cylinder, PinElasticity,
+    PinHold, PinMotion, check, diameter_change, solve_contact,
 };
 use rodstudy::fem::mesh::ring::{Ring, ring_tet10};
 use rodstudy::fem::mesh::structured::{TwoEyePlate, two_eye_plate};
@@ -43,6 +44,7 @@ fn pin(faces: Vec<[usize; 6]>, radius: f64, motion: PinMotion) -> Cylinder {
         faces,
         nominal_bore_radius_m: None,
         motion,
+        elastic: None,
     }
 }
 
@@ -65,7 +67,20 @@ fn problem(mesh: &TetMesh, cylinders: Vec<Cylinder>) -> ContactProblem<'_> {
 fn recheck(p: &ContactProblem, s: &ContactSolution) {
     let pressures: Vec<Vec<f64>> = s.cylinders.iter().map(|c| c.pressure_pa.clone()).collect();
     let pins: Vec<[f64; 3]> = s.cylinders.iter().map(|c| c.pin_displacement_m).collect();
-    let (c, r, _) = check(p, &s.displacements, &pressures, &pins, &s.restraint.dofs).unwrap();
+    let deflections: Vec<Vec<f64>> = s
+        .cylinders
+        .iter()
+        .map(|c| c.pin_deflection_m.clone())
+        .collect();
+    let (c, r, _) = check(
+        p,
+        &s.displacements,
+        &pressures,
+        &pins,
+        &deflections,
+        &s.restraint.dofs,
+    )
+    .unwrap();
     c.verify(&p.tolerances).unwrap();
     assert_eq!(r.dofs, s.restraint.dofs);
     assert_eq!(r.force_n, s.restraint.force_n);
@@ -510,6 +525,82 @@ fn a_factorised_system_serves_other_pin_forces_as_a_fresh_solve_does() {
     let mut other = p.clone();
     other.prescribed.push((2, 0.0));
     assert!(system.solve(&other).is_err());
+}
+
+/// The two-eye plate on pins A (20 kN along AB, 20 µm clearance) and B (fixed, 10 µm), both of
+/// `elastic` (`None`: rigid).
+fn two_pins(elastic: Option<PinElasticity>) -> (ContactSolution, f64) {
+    let (mesh, fa, fb, plate) = two_eye();
+    let mut pa = pin(
+        fa,
+        plate.bore_a_radius - 20e-6,
+        PinMotion::Force([20e3, 0.0, 0.0]),
+    );
+    let mut pb = pin(fb, plate.bore_b_radius - 10e-6, PinMotion::Fixed);
+    pb.axis_point_m = [plate.length, 0.0, 0.0];
+    pa.elastic = elastic;
+    pb.elastic = elastic;
+    let p = problem(&mesh, vec![pa, pb]);
+    let s = solve_contact(&p).unwrap();
+    // equilibrium, complementarity on the gaps with the pins' deflection, no penetration
+    recheck(&p, &s);
+    let u_max = s.displacements.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    (s, u_max)
+}
+
+#[test]
+fn an_elastic_pin_tends_to_the_rigid_pin_as_its_modulus_grows() {
+    let (rigid, _) = two_pins(None);
+    let stiff = |factor: f64, hold: PinHold| PinElasticity {
+        material: Material {
+            youngs_modulus_pa: factor * E,
+            poisson_ratio: NU,
+        },
+        hold,
+        inner_ratio: 0.2,
+    };
+    for hold in [PinHold::Core, PinHold::Ends] {
+        let mut last = f64::INFINITY;
+        for factor in [1.0, 1e2, 1e4] {
+            let (s, u_max) = two_pins(Some(stiff(factor, hold)));
+            let (a, r) = (&s.cylinders[0], &rigid.cylinders[0]);
+            let du = s
+                .displacements
+                .iter()
+                .zip(&rigid.displacements)
+                .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+                / u_max;
+            let deflection = a
+                .pin_deflection_m
+                .iter()
+                .fold(0.0f64, |m, v| m.max(v.abs()));
+            eprintln!(
+                "{hold:?} E × {factor:e}: peak pressure {:.4e} Pa (rigid {:.4e}), arc {:.1}° \
+                 ({:.1}°), pin A {:.4e} m ({:.4e}), pin deflection {deflection:.3e} m, \
+                 displacement off by {du:.2e} of its largest",
+                a.peak_pressure_pa,
+                r.peak_pressure_pa,
+                a.arc_deg,
+                r.arc_deg,
+                a.pin_displacement_m[0],
+                r.pin_displacement_m[0],
+            );
+            // the pin's own compliance widens the arc and lets the pin travel further; held at a
+            // core it lowers the peak, held at its ends it bends and loads the bore's faces
+            // more; the difference falls with the modulus, as 1/E
+            assert!(a.arc_deg >= r.arc_deg - 1e-9);
+            if hold == PinHold::Core {
+                assert!(a.peak_pressure_pa <= r.peak_pressure_pa * (1.0 + 1e-9));
+            }
+            assert!(a.pin_displacement_m[0] >= r.pin_displacement_m[0]);
+            assert!(du < last, "{du} after {last}");
+            if factor == 1.0 {
+                assert!(du > 1e-3, "a steel pin changes nothing: {du}");
+            }
+            last = du;
+        }
+        assert!(last < 1e-3, "{hold:?}: {last}");
+    }
 }
 
 #[test]

@@ -81,6 +81,7 @@ fn the_contact_load_case_is_the_direct_contact_solve_and_balances() {
             clearance_a_m: CLEARANCE_M,
             clearance_b_m: CLEARANCE_M,
             tolerances: ContactTolerances::default(),
+            elastic: None,
         },
         &options,
     )
@@ -238,6 +239,7 @@ fn a_cycle_instant_without_inertia_is_the_static_contact_case() {
             clearance_a_m: CLEARANCE_M,
             clearance_b_m: CLEARANCE_M,
             tolerances: ContactTolerances::default(),
+            elastic: None,
         },
         &RodOptions::default(),
     )

@@ -98,6 +98,7 @@ pub fn bench_contact(n_side: usize, repeats: usize) -> Result<ContactBench> {
                 faces: fa,
                 nominal_bore_radius_m: None,
                 motion: PinMotion::Force(force),
+                elastic: None,
             },
             Cylinder {
                 axis_point_m: [plate.length, 0.0, 0.0],
@@ -106,6 +107,7 @@ pub fn bench_contact(n_side: usize, repeats: usize) -> Result<ContactBench> {
                 faces: fb,
                 nominal_bore_radius_m: None,
                 motion: PinMotion::Fixed,
+                elastic: None,
             },
         ],
         tolerances: ContactTolerances::default(),
@@ -172,6 +174,7 @@ pub fn bench_contact_rod(
         clearance_a_m: 10e-6,
         clearance_b_m: 10e-6,
         tolerances: ContactTolerances::default(),
+        elastic: None,
     };
     let (t_con, con) = median_time(repeats, || {
         solve_rod_contact(&mesh, &material, &bores, &pins, &options)

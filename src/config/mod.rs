@@ -31,6 +31,9 @@
 //! clearance_a_mm = 0.0175      # contact: radial clearance of the crank pin in bore A
 //!                              # (negative: interference); default 0.35 ‰ of the bore diameter
 //! clearance_b_mm = 0.00875     # contact: the piston pin's in bore B; same default
+//! pins = "rigid"               # contact: or "elastic" (pins of the rod's material around a
+//!                              # rigid core) or "elastic-ends" (held at the bore's faces)
+//! pin_inner_ratio = 0.2        # elastic pins: the core's (or the pin's bore's) radius over the bore's
 //! load_model_error = true      # solve the other load models on the final mesh (the error bar's
 //!                              # load-model part)
 //!
@@ -79,6 +82,7 @@ pub use engine::{EngineConfig, TracePath};
 pub use material::MaterialConfig;
 
 use crate::rod::pin_load::BoreLoad;
+use crate::rod::pin_model::PinModel;
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -147,6 +151,15 @@ pub struct FemConfig {
     /// The same for the piston pin in bore B, mm.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub clearance_b_mm: Option<f64>,
+    /// With contact: `"rigid"` pins (default, not written into `results.json`), `"elastic"` (of
+    /// the rod's material, held at a rigid core) or `"elastic-ends"` (held at the bore's faces)
+    /// ([`crate::rod::pin_model::PinModel`]).
+    #[serde(skip_serializing_if = "PinModel::is_rigid")]
+    pub pins: PinModel,
+    /// Elastic pins: the core's (or the pin's bore's) radius over the bore's, in (0, 1); absent:
+    /// 0.2.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pin_inner_ratio: Option<f64>,
     /// Solve the judged cases on the final mesh under the other load models too (uniform, cosine
     /// and contact): the load-model part of each case's error bar
     /// (`estimated_load_model_error_rel`). The default is not written into `results.json`.
@@ -224,6 +237,8 @@ impl Default for FemConfig {
             bore_load: BoreLoad::Uniform,
             clearance_a_mm: None,
             clearance_b_mm: None,
+            pins: PinModel::Rigid,
+            pin_inner_ratio: None,
             load_model_error: true,
             symmetry: Symmetry::Auto,
         }
@@ -433,6 +448,11 @@ impl StudyConfig {
                     "`{key}` must be a radial clearance under 1 mm (negative: an interference), got {c} mm"
                 );
             }
+        }
+        if let Some(r) = self.fem.pin_inner_ratio
+            && !(r > 0.0 && r < 1.0)
+        {
+            bail!("`fem.pin_inner_ratio` must lie between 0 and 1 (exclusive), got {r}");
         }
         check_upper_bounds(&[
             (

@@ -16,6 +16,7 @@
 //! faces of the transition ring pass the radius test (stretching the extent in a few places), the
 //! length that holds the middle 80 % of the area, scaled to the whole.
 
+use super::pin_model::PinModel;
 use serde::{Deserialize, Serialize};
 
 use crate::fem::boundary::{
@@ -59,6 +60,13 @@ pub struct BoreSpec {
     pub clearance_a_m: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub clearance_b_m: Option<f64>,
+    /// With contact: rigid pins (default) or elastic ones ([`PinModel`], `[fem] pins`).
+    #[serde(default, skip_serializing_if = "PinModel::is_rigid")]
+    pub pins: PinModel,
+    /// With elastic pins: their inner radius over the bore's; `None`:
+    /// [`super::pin_model::DEFAULT_PIN_INNER_RATIO`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pin_inner_ratio: Option<f64>,
 }
 
 /// Radial clearance of a pin in its bore where none is given, as a fraction of the bore's
@@ -99,7 +107,18 @@ impl BoreSpec {
             bore_load: BoreLoad::Uniform,
             clearance_a_m: None,
             clearance_b_m: None,
+            pins: PinModel::Rigid,
+            pin_inner_ratio: None,
         }
+    }
+
+    /// The pins' elasticity under contact, of `material` ([`PinModel::elasticity`]); `None`:
+    /// rigid pins.
+    pub fn pin_elasticity(
+        &self,
+        material: &crate::fem::material::Material,
+    ) -> Result<Option<crate::fem::contact::PinElasticity>> {
+        self.pins.elasticity(material, self.pin_inner_ratio)
     }
 
     /// Unit axis; error if zero or not finite.

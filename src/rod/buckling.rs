@@ -82,6 +82,7 @@ pub fn rod_buckling_contact(
             bores.unit_axis()?,
             c_a,
             PinMotion::Force(force),
+            bores.pin_elasticity(material)?,
         )?],
         tolerances: ContactTolerances::default(),
     })?;

@@ -27,8 +27,8 @@ use super::bores::{BoreSpec, BoreSurface, default_clearance_m};
 use super::cases::{CaseDirection, STATIC_CASES};
 use super::records::PinContactRecord;
 use crate::fem::contact::{
-    ContactProblem, ContactSolution, ContactTolerances, Cylinder, PinMotion, diameter_change,
-    solve_contact,
+    ContactProblem, ContactSolution, ContactTolerances, Cylinder, PinElasticity, PinMotion,
+    diameter_change, solve_contact,
 };
 use crate::fem::error::{FemError, Result};
 use crate::fem::load::SurfaceLoad;
@@ -49,12 +49,14 @@ pub fn clearances_m(bores: &BoreSpec, loaded: &BoreSurface, fixed: &BoreSurface)
     ]
 }
 
-/// A rigid pin in `bore` with radial clearance `clearance` (m), moving as `motion`.
+/// A pin in `bore` with radial clearance `clearance` (m), moving as `motion`, rigid or elastic
+/// (`elastic`).
 pub fn pin_in(
     bore: &BoreSurface,
     axis: [f64; 3],
     clearance: f64,
     motion: PinMotion,
+    elastic: Option<PinElasticity>,
 ) -> Result<Cylinder> {
     let radius = bore.radius_m - clearance;
     if !(clearance.is_finite() && radius > 0.0) {
@@ -72,6 +74,7 @@ pub fn pin_in(
         // the gap from the bore's radius: a faceted wall's midside nodes lie inside it
         nominal_bore_radius_m: Some(bore.radius_m),
         motion,
+        elastic,
     })
 }
 
@@ -158,6 +161,7 @@ pub(super) fn contact_solutions(
     held: &[usize],
 ) -> Result<(StaticSolution, Vec<SurfaceLoad>, Vec<ContactCase>)> {
     let [c_a, c_b] = clearances_m(bores, loaded, fixed);
+    let elastic = bores.pin_elasticity(material)?;
     let n = mesh.n_dofs();
     let mut displacements = Vec::with_capacity(cases.len());
     let mut reactions = Vec::with_capacity(cases.len());
@@ -170,10 +174,16 @@ pub(super) fn contact_solutions(
         let t = Instant::now();
         let pin_force = dir.map(|v| v * force * load_share);
         let pin_b = def.direction == CaseDirection::AlongRod;
-        let mut cylinders = vec![pin_in(loaded, axis, c_a, PinMotion::Force(pin_force))?];
+        let mut cylinders = vec![pin_in(
+            loaded,
+            axis,
+            c_a,
+            PinMotion::Force(pin_force),
+            elastic,
+        )?];
         let mut prescribed: Vec<(usize, f64)> = held.iter().map(|&d| (d, 0.0)).collect();
         if pin_b {
-            cylinders.push(pin_in(fixed, axis, c_b, PinMotion::Fixed)?);
+            cylinders.push(pin_in(fixed, axis, c_b, PinMotion::Fixed, elastic)?);
         } else {
             let on_plane: std::collections::HashSet<usize> = held.iter().copied().collect();
             prescribed.extend(

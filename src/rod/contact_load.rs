@@ -17,8 +17,8 @@ use super::judged::{Bands, DEFAULT_FIXED_BAND_M, DEFAULT_SINGULAR_BAND_M, judged
 use super::solve::RodOptions;
 use crate::fem::boundary::{boundary_faces, norm};
 use crate::fem::contact::{
-    ContactSolution, ContactTolerances, CylinderContact, DiameterChange, PinMotion, Restraint,
-    diameter_change, solve_contact,
+    ContactSolution, ContactTolerances, CylinderContact, DiameterChange, PinElasticity, PinMotion,
+    Restraint, diameter_change, solve_contact,
 };
 use crate::fem::error::{FemError, Result};
 use crate::fem::material::Material;
@@ -36,6 +36,8 @@ pub struct PinContact {
     pub clearance_b_m: f64,
     /// Acceptance limits of the contact solution.
     pub tolerances: ContactTolerances,
+    /// `None`: rigid pins; else both pins' elasticity ([`crate::fem::contact::elastic_pin`]).
+    pub elastic: Option<PinElasticity>,
 }
 
 /// The rod loaded through its pins.
@@ -94,8 +96,15 @@ pub fn solve_rod_contact(
             axis,
             pins.clearance_a_m,
             PinMotion::Force(pins.force_n),
+            pins.elastic,
         )?,
-        pin_in(&fixed, axis, pins.clearance_b_m, PinMotion::Fixed)?,
+        pin_in(
+            &fixed,
+            axis,
+            pins.clearance_b_m,
+            PinMotion::Fixed,
+            pins.elastic,
+        )?,
     ];
     let problem = crate::fem::contact::ContactProblem {
         mesh,
@@ -182,6 +191,7 @@ mod tests {
                 clearance_a_m: clearance,
                 clearance_b_m: clearance,
                 tolerances: ContactTolerances::default(),
+                elastic: None,
             };
             let c = solve_rod_contact(&mesh, &material, &spec, &pins, &options).unwrap();
             // contact resultant = pin force (by construction of the force pin, [`solve_contact`]);
@@ -224,6 +234,7 @@ mod tests {
             clearance_a_m: 1.0,
             clearance_b_m: 0.0,
             tolerances: ContactTolerances::default(),
+            elastic: None,
         };
         let r = solve_rod_contact(
             &mesh,

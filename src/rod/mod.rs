@@ -23,6 +23,7 @@ pub mod half_model;
 pub mod judged;
 pub mod load_models;
 pub mod pin_load;
+pub mod pin_model;
 pub mod records;
 pub mod refinement;
 pub mod segment_grid;

@@ -23,8 +23,9 @@ use crate::fem::element::element_stiffness;
 use crate::fem::error::{FemError, Result};
 
 /// Checks the displacements `u` (3 per node), the wall pressures `pressure` (per cylinder, per
-/// wall node, Pa) and the pin translations `pins` (m) of `problem`, with the support of the free
-/// motions on `support` (DOFs). Returns the figures, the support's reaction and the reactions
+/// wall node, Pa), the pin translations `pins` (m) and each elastic pin's deflection towards its
+/// axis at its wall nodes (`deflection`, m; empty for a rigid pin) of `problem`, with the support
+/// of the free motions on `support` (DOFs). Returns the figures, the support's reaction and the reactions
 /// K u − f − f_c at the prescribed DOFs and the support's (3 per node, zero elsewhere); it does
 /// not judge them ([`ContactCheck::verify`] does).
 pub fn check(
@@ -32,11 +33,16 @@ pub fn check(
     u: &[f64],
     pressure: &[Vec<f64>],
     pins: &[[f64; 3]],
+    deflection: &[Vec<f64>],
     support: &[usize],
 ) -> Result<(ContactCheck, Restraint, Vec<f64>)> {
     let mesh = problem.mesh;
     let n = mesh.n_dofs();
-    if u.len() != n || pressure.len() != problem.cylinders.len() || pins.len() != pressure.len() {
+    if u.len() != n
+        || pressure.len() != problem.cylinders.len()
+        || pins.len() != pressure.len()
+        || deflection.len() != pressure.len()
+    {
         return Err(FemError::InvalidInput(
             "contact check: sizes do not match the problem".into(),
         ));
@@ -83,7 +89,19 @@ pub fn check(
     // gaps, penetration, complementarity
     let mut weighted = Vec::with_capacity(walls.len());
     for (k, wall) in walls.iter().enumerate() {
-        let g = wall.gaps(u, pins[k]);
+        let mut g = wall.gaps(u, pins[k]);
+        if !deflection[k].is_empty() {
+            if deflection[k].len() != g.len() {
+                return Err(FemError::InvalidInput(format!(
+                    "contact check: cylinder {k} has {} wall nodes, {} deflections",
+                    g.len(),
+                    deflection[k].len()
+                )));
+            }
+            for (ga, d) in g.iter_mut().zip(&deflection[k]) {
+                *ga += d;
+            }
+        }
         for (a, ga) in g.iter().enumerate() {
             out.gap_scale_m = out
                 .gap_scale_m

@@ -14,6 +14,7 @@
 //! pressure p ≥ 0 pushes the wall away from the axis: the traction on the body is p e_r, and the
 //! body pushes the pin with −p e_r.
 
+use super::elastic_pin::PinElasticity;
 use crate::fem::boundary::{dot, norm};
 use crate::fem::error::{FemError, Result};
 
@@ -46,6 +47,8 @@ pub struct Cylinder {
     pub nominal_bore_radius_m: Option<f64>,
     /// Fixed or force-driven.
     pub motion: PinMotion,
+    /// `None`: the pin is rigid; else its elasticity ([`super::elastic_pin`]).
+    pub elastic: Option<PinElasticity>,
 }
 
 impl Cylinder {

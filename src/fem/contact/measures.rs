@@ -80,6 +80,7 @@ pub fn summarise(wall: &Wall, lambda: &[f64], gap: &[f64], pin: [f64; 3]) -> Cyl
         gap_m: gap.to_vec(),
         angle_deg,
         pin_displacement_m: pin,
+        pin_deflection_m: Vec::new(),
         resultant_n: res,
         peak_pressure_pa: peak,
         peak_nodal_pressure_pa: lambda.iter().fold(0.0, |a, l| a.max(*l)),

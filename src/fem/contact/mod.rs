@@ -14,12 +14,16 @@
 //! it is returned: equilibrium, the pin forces' resultants, complementarity, penetration, no
 //! tensile pressure ([`check`]). Pressure, gap, arc, peak and the bore's ovality: [`measures`].
 //!
+//! A pin may be elastic instead of rigid: its own compliance, from a mesh extruded from the wall,
+//! adds to the body's ([`elastic_pin`]).
+//!
 //! See `docs/contact.md` for the formulation, the verification and the cost.
 
 pub mod acceptance;
 pub mod check;
 pub mod compliance;
 pub mod cylinder;
+pub mod elastic_pin;
 pub mod lcp;
 pub mod measures;
 pub mod modes;
@@ -32,6 +36,7 @@ pub mod weights;
 pub use acceptance::ContactCheck;
 pub use check::check;
 pub use cylinder::{Cylinder, PinMotion};
+pub use elastic_pin::{PinElasticity, PinHold};
 pub use measures::{DiameterChange, diameter_change};
 pub use problem::{
     ContactProblem, ContactSolution, ContactTimings, ContactTolerances, CylinderContact, Restraint,

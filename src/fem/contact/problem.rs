@@ -45,6 +45,9 @@ pub struct CylinderContact {
     pub angle_deg: Vec<f64>,
     /// The pin's translation, m (zero for a fixed pin).
     pub pin_displacement_m: [f64; 3],
+    /// An elastic pin's surface displacement towards its axis at each wall node, m (empty for a
+    /// rigid pin); `gap_m` includes it.
+    pub pin_deflection_m: Vec<f64>,
     /// Resultant of the contact forces on the body, N.
     pub resultant_n: [f64; 3],
     /// Largest smoothed contact pressure, Pa.

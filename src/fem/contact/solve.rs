@@ -196,13 +196,30 @@ impl ContactSystem<'_> {
                 fc
             })
             .collect();
-        let (chk, mut restraint, reactions) = check(problem, &u, &pressures, &pins, &fl.support)?;
+        // an elastic pin's own deflection under the pressure opens the gaps
+        let deflections: Vec<Vec<f64>> = self
+            .elastic
+            .iter()
+            .zip(&pressures)
+            .map(|(pin, lam)| pin.as_ref().map_or_else(Vec::new, |p| p.deflection(lam)))
+            .collect();
+        let (chk, mut restraint, reactions) =
+            check(problem, &u, &pressures, &pins, &deflections, &fl.support)?;
         restraint.free_motions = self.free_motions;
         let cylinders = walls
             .iter()
             .zip(&pressures)
             .zip(&pins)
-            .map(|((w, lam), pin)| summarise(w, lam, &w.gaps(&u, *pin), *pin))
+            .zip(deflections)
+            .map(|(((w, lam), pin), deflection)| {
+                let mut gaps = w.gaps(&u, *pin);
+                for (g, d) in gaps.iter_mut().zip(&deflection) {
+                    *g += d;
+                }
+                let mut c = summarise(w, lam, &gaps, *pin);
+                c.pin_deflection_m = deflection;
+                c
+            })
             .collect();
         timings.rest_s += t.elapsed().as_secs_f64();
         chk.verify(&problem.tolerances)?;

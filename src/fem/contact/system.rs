@@ -14,6 +14,7 @@ use std::time::Instant;
 
 use super::compliance::{Compliance, NodalFrames};
 use super::cylinder::{Cylinder, PinMotion};
+use super::elastic_pin::ElasticPin;
 use super::modes::{Floating, floating};
 use super::problem::{ContactProblem, ContactTimings};
 use super::weights::Wall;
@@ -38,10 +39,10 @@ pub struct ContactSystem<'a> {
     pub(super) m: usize,
     pub(super) fl: Floating,
     pub(super) dofs: DofMap,
-    dirichlet_rhs: Vec<f64>,
-    frames: Option<NodalFrames>,
-    factor: CholeskyFactor,
-    compliance: Compliance,
+    /// K_S factorised, with the rows' compliance.
+    fact: Factorised,
+    /// Per wall, its pin's own compliance where the pin is elastic ([`super::elastic_pin`]).
+    pub(super) elastic: Vec<Option<ElasticPin>>,
     /// The walls of the force-driven pins, in order.
     pub(super) force_pins: Vec<usize>,
     /// Unknowns y = (α, w): k floating motions, two translations per force-driven pin.
@@ -102,33 +103,30 @@ impl<'a> ContactSystem<'a> {
         let mut prescribed = problem.prescribed.clone();
         prescribed.extend(fl.support.iter().map(|&d| (d, 0.0)));
         let dofs = DofMap::new(n, &prescribed)?;
-        let n_eq = dofs.n_eq();
         let mut setup = ContactTimings {
             rest_s: t0.elapsed().as_secs_f64(),
             ..ContactTimings::default()
         };
 
         // K_S, factorised once
+        let fact = Factorised::new(mesh, &problem.material, problem.quadrature, &dofs, &walls)?;
+        setup.assembly_s = fact.assembly_s;
+        setup.factorisation_s = fact.factorisation_s;
         let t = Instant::now();
-        let asm = assemble(mesh, &problem.material, problem.quadrature, &dofs)?;
-        setup.assembly_s = t.elapsed().as_secs_f64();
-        let t = Instant::now();
-        // in the wall nodes' radial frames, the radial equations last ([`super::compliance`])
-        let rotated =
-            NodalFrames::new(&walls, &dofs).and_then(|f| f.rotate_matrix(&asm.k).map(|k| (f, k)));
-        let order = nested_dissection(mesh, &dofs)?;
-        let (frames, factor) = match rotated {
-            Some((f, k_rot)) => {
-                let order = f.order_last(&order);
-                let symbolic = SymbolicFactor::analyse(&k_rot, Some(&order))?;
-                (Some(f), CholeskyFactor::factorise(&symbolic, &k_rot)?)
-            }
-            None => {
-                let symbolic = SymbolicFactor::analyse(&asm.k, Some(&order))?;
-                (None, CholeskyFactor::factorise(&symbolic, &asm.k)?)
-            }
-        };
-        setup.factorisation_s = t.elapsed().as_secs_f64();
+        let elastic = problem
+            .cylinders
+            .iter()
+            .zip(&walls)
+            .map(|(cyl, wall)| {
+                cyl.elastic
+                    .as_ref()
+                    .map(|e| {
+                        ElasticPin::new(mesh, cyl, wall, &problem.prescribed, e, problem.quadrature)
+                    })
+                    .transpose()
+            })
+            .collect::<Result<Vec<_>>>()?;
+        setup.factorisation_s += t.elapsed().as_secs_f64();
 
         let t = Instant::now();
         // Z = [CΦ, −B]
@@ -165,20 +163,6 @@ impl<'a> ContactSystem<'a> {
                     .collect()
             })
             .collect();
-        // eq numbers of the wall nodes' DOFs, to apply C to a vector of equations
-        let eqs: Vec<Vec<[Option<usize>; 3]>> = walls
-            .iter()
-            .map(|w| {
-                w.nodes
-                    .iter()
-                    .map(|&nd| std::array::from_fn(|j| dofs.eq(3 * nd + j)))
-                    .collect()
-            })
-            .collect();
-        let compliance = match &frames {
-            Some(f) => Compliance::trailing(&factor, &walls, &f.radial())?,
-            None => Compliance::solves(n_eq, &walls, &eqs),
-        };
         setup.rest_s += t.elapsed().as_secs_f64();
         Ok(ContactSystem {
             mesh,
@@ -190,10 +174,8 @@ impl<'a> ContactSystem<'a> {
             m,
             fl,
             dofs,
-            dirichlet_rhs: asm.dirichlet_rhs,
-            frames,
-            factor,
-            compliance,
+            fact,
+            elastic,
             force_pins,
             nz,
             basis,
@@ -215,6 +197,7 @@ impl<'a> ContactSystem<'a> {
                     && a.radius_m == b.radius_m
                     && a.faces == b.faces
                     && a.nominal_bore_radius_m == b.nominal_bore_radius_m
+                    && a.elastic == b.elastic
                     && matches!(
                         (a.motion, b.motion),
                         (PinMotion::Fixed, PinMotion::Fixed)
@@ -247,20 +230,14 @@ impl<'a> ContactSystem<'a> {
         Ok(())
     }
 
-    /// K x = b through the factor (of K' = Tᵀ K T when rotated: x = T K'⁻¹ Tᵀ b), in place.
+    /// K x = b through the factor, in place.
     pub(super) fn solve_k(&self, b: &mut [f64]) {
-        if let Some(f) = &self.frames {
-            f.rotate(b, true);
-        }
-        self.factor.solve_in_place(b, 1);
-        if let Some(f) = &self.frames {
-            f.rotate(b, false);
-        }
+        self.fact.solve(b);
     }
 
     /// The right-hand side of K_S for the nodal forces `f` (3 per node).
     pub(super) fn rhs_of(&self, f: &[f64]) -> Vec<f64> {
-        let mut b = self.dirichlet_rhs.clone();
+        let mut b = self.fact.dirichlet_rhs.clone();
         for (d, v) in f.iter().enumerate() {
             if let Some(q) = self.dofs.eq(d) {
                 b[q] += v;
@@ -286,19 +263,112 @@ impl<'a> ContactSystem<'a> {
             .filter(|j| !cache.contains_key(j))
             .collect();
         if !missing.is_empty() {
-            for (j, col) in missing
-                .iter()
-                .zip(self.compliance.columns(&self.factor, &missing))
-            {
+            let mut cols = self.fact.compliance.columns(&self.fact.factor, &missing);
+            // an elastic pin adds its own compliance on its wall's rows
+            for (w, (wall, pin)) in self.walls.iter().zip(&self.elastic).enumerate() {
+                let Some(pin) = pin else { continue };
+                let here: Vec<usize> = (0..missing.len())
+                    .filter(|&i| self.walls_of_row(missing[i]) == w)
+                    .collect();
+                let local: Vec<usize> = here.iter().map(|&i| missing[i] - wall.offset).collect();
+                for (&i, pc) in here.iter().zip(pin.columns(&local)) {
+                    for (b, v) in pc.iter().enumerate() {
+                        cols[i][wall.offset + b] += v;
+                    }
+                }
+            }
+            for (j, col) in missing.iter().zip(cols) {
                 cache.insert(*j, col);
             }
         }
         (js.iter().map(|j| cache[j].clone()).collect(), missing.len())
     }
 
+    /// The wall of contact row `j`.
+    fn walls_of_row(&self, j: usize) -> usize {
+        self.walls
+            .iter()
+            .position(|w| j >= w.offset && j < w.offset + w.len())
+            .expect("a contact row lies on a wall")
+    }
+
     /// Equations of K_S.
     pub fn equations(&self) -> usize {
         self.dofs.n_eq()
+    }
+}
+
+/// K of a body assembled with `dofs` and factorised for the contact compliance of `walls`: in the
+/// wall nodes' radial frames with the radial equations last where the supports allow it
+/// ([`super::compliance`]), else as it is with the columns solved one by one.
+pub(super) struct Factorised {
+    pub dirichlet_rhs: Vec<f64>,
+    pub frames: Option<NodalFrames>,
+    pub factor: CholeskyFactor,
+    pub compliance: Compliance,
+    pub assembly_s: f64,
+    pub factorisation_s: f64,
+}
+
+impl Factorised {
+    pub fn new(
+        mesh: &TetMesh,
+        material: &Material,
+        quadrature: QuadratureChoice,
+        dofs: &DofMap,
+        walls: &[Wall],
+    ) -> Result<Factorised> {
+        let t = Instant::now();
+        let asm = assemble(mesh, material, quadrature, dofs)?;
+        let assembly_s = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let rotated =
+            NodalFrames::new(walls, dofs).and_then(|f| f.rotate_matrix(&asm.k).map(|k| (f, k)));
+        let order = nested_dissection(mesh, dofs)?;
+        let (frames, factor) = match rotated {
+            Some((f, k_rot)) => {
+                let order = f.order_last(&order);
+                let symbolic = SymbolicFactor::analyse(&k_rot, Some(&order))?;
+                (Some(f), CholeskyFactor::factorise(&symbolic, &k_rot)?)
+            }
+            None => {
+                let symbolic = SymbolicFactor::analyse(&asm.k, Some(&order))?;
+                (None, CholeskyFactor::factorise(&symbolic, &asm.k)?)
+            }
+        };
+        // eq numbers of the wall nodes' DOFs, to apply C to a vector of equations
+        let eqs: Vec<Vec<[Option<usize>; 3]>> = walls
+            .iter()
+            .map(|w| {
+                w.nodes
+                    .iter()
+                    .map(|&nd| std::array::from_fn(|j| dofs.eq(3 * nd + j)))
+                    .collect()
+            })
+            .collect();
+        let compliance = match &frames {
+            Some(f) => Compliance::trailing(&factor, walls, &f.radial())?,
+            None => Compliance::solves(dofs.n_eq(), walls, &eqs),
+        };
+        Ok(Factorised {
+            dirichlet_rhs: asm.dirichlet_rhs,
+            frames,
+            factor,
+            compliance,
+            assembly_s,
+            factorisation_s: t.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// K x = b through the factor (of K' = Tᵀ K T when rotated: x = T K'⁻¹ Tᵀ b), in place.
+    pub fn solve(&self, b: &mut [f64]) {
+        if let Some(f) = &self.frames {
+            f.rotate(b, true);
+        }
+        self.factor.solve_in_place(b, 1);
+        if let Some(f) = &self.frames {
+            f.rotate(b, false);
+        }
     }
 }
 

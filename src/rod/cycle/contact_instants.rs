@@ -174,6 +174,7 @@ pub fn contact_instants(
     let (loaded, fixed) = find_bores(solved, &boundary_faces(solved)?, bores)?;
     let axis = bores.unit_axis()?;
     let [c_a, c_b] = clearances_m(bores, &loaded, &fixed);
+    let elastic = bores.pin_elasticity(material)?;
     let body: Vec<Vec<f64>> = [
         BodyShape::UniformX,
         BodyShape::UniformY,
@@ -215,8 +216,8 @@ pub fn contact_instants(
             prescribed: held.clone(),
             loads,
             cylinders: vec![
-                pin_in(&loaded, axis, c_a, PinMotion::Force(f_a))?,
-                pin_in(&fixed, axis, c_b, PinMotion::Fixed)?,
+                pin_in(&loaded, axis, c_a, PinMotion::Force(f_a), elastic)?,
+                pin_in(&fixed, axis, c_b, PinMotion::Fixed, elastic)?,
             ],
             tolerances: ContactTolerances {
                 free_mode_reaction_rel: None,

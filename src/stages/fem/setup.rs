@@ -99,6 +99,8 @@ impl Setup {
         bores.bore_load = config.fem.bore_load;
         bores.clearance_a_m = config.fem.clearance_a_mm.map(|c| c * 1e-3);
         bores.clearance_b_m = config.fem.clearance_b_mm.map(|c| c * 1e-3);
+        bores.pins = config.fem.pins;
+        bores.pin_inner_ratio = config.fem.pin_inner_ratio;
         Ok(Setup {
             step,
             bores,
