@@ -209,10 +209,11 @@ fn the_two_eye_plate_on_two_pins_against_calculix() {
 }
 
 /// The same plate on two elastic steel pins, each a solid pin around a rigid core of a fifth of
-/// its radius (`PinHold::Core`; ccx: C3D20 pins held on their inner surface, 3 bricks through
-/// the wall): the pins' own compliance widens the arcs and lowers the peaks (by 11–19 % against
-/// rigid pins at this clearance, docs/contact.md); rodstudy's pin, extruded from the wall, against
-/// ccx's.
+/// its radius, flush with the plate's faces (`PinHold::Core`; ccx: C3D20 pins held on their
+/// inner surface, 3 bricks through the wall, none beyond the faces): the pins' own compliance
+/// widens the arcs and lowers the peaks; rodstudy's pin, extruded from the wall, against ccx's:
+/// far-field von Mises within 2 %, bore A's peak smoothed pressure within 3 %, pin A's travel
+/// within 1 %, each end of the arc inside ccx's end face.
 #[test]
 fn the_two_eye_plate_on_two_elastic_pins_against_calculix() {
     let plate = TwoEyePlate {
@@ -296,6 +297,18 @@ fn the_two_eye_plate_on_two_elastic_pins_against_calculix() {
         (vm_ours / vm_ccx - 1.0).abs() < 0.02,
         "{vm_ours} vs {vm_ccx}"
     );
-    assert!((p_ours / p_ccx - 1.0).abs() < 0.02, "{p_ours} vs {p_ccx}");
+    // the pressure falls towards the bore's faces (ccx: 19.2 MPa there, 23.2 at mid-thickness);
+    // rodstudy's pin follows the wall's two layers along the axis, ccx's has four bricks
+    assert!((p_ours / p_ccx - 1.0).abs() < 0.03, "{p_ours} vs {p_ccx}");
     assert!((w_ours / w_ccx - 1.0).abs() < 0.01, "{w_ours} vs {w_ccx}");
+    // each end of the arc inside ccx's end face
+    for side in 0..2 {
+        let span = &a["arc_end_elements_deg"][side];
+        let (lo, hi) = (span[0].as_f64().unwrap(), span[1].as_f64().unwrap());
+        let end = ours.bore_a.arc_ends_deg[side];
+        assert!(
+            end >= lo - 1e-6 && end <= hi + 1e-6,
+            "{end} outside [{lo}, {hi}]"
+        );
+    }
 }

@@ -617,4 +617,18 @@ mod tests {
         let bad: StudyConfig = toml::from_str("[fem]\npoisson_ratio = 0.5\n").unwrap();
         assert!(bad.check().is_err());
     }
+
+    #[test]
+    fn the_pins_are_rigid_unless_said_and_an_inner_ratio_lies_in_0_1() {
+        assert_eq!(FemConfig::default().pins, PinModel::Rigid);
+        let c: StudyConfig =
+            toml::from_str("[fem]\npins = \"elastic-ends\"\npin_inner_ratio = 0.5\n").unwrap();
+        assert_eq!(c.fem.pins, PinModel::ElasticEnds);
+        c.check().unwrap();
+        let e = toml::from_str::<StudyConfig>("[fem]\npins = \"soft\"\n").unwrap_err();
+        assert!(e.to_string().contains("unknown variant"), "{e}");
+        let bad: StudyConfig = toml::from_str("[fem]\npin_inner_ratio = 1.0\n").unwrap();
+        let e = bad.check().unwrap_err().to_string();
+        assert!(e.contains("pin_inner_ratio"), "{e}");
+    }
 }

@@ -367,7 +367,7 @@ fn design_section(s: &mut String, r: &RankRow, out: &Path) {
                 out,
                 &format!("{dir}/contact_{}.svg", case.name),
                 &format!(
-                    "{} case: the contact pressure around the crank-pin bore (frictionless contact with a rigid pin at its clearance) against the cosine bearing pressure and the uniform traction of the same force",
+                    "{} case: the contact pressure around the crank-pin bore (frictionless contact with the pin at its clearance) against the cosine bearing pressure and the uniform traction of the same force",
                     crate::rod::cases::label(&case.name)
                 ),
             );
@@ -454,8 +454,14 @@ fn contact_line(
         _ => "bore B clamped (a force across the rod)".into(),
     };
     format!(
-        "{} case: bore A arc {:.0}° ({:.0}° to {:.0}° from the force), peak pressure {:.1} MPa; {b}; bore A's diameter changes {:+.2} µm along the force, {:+.2} µm across; radial clearances {:.1} / {:.1} µm",
+        "{} case{}: bore A arc {:.0}° ({:.0}° to {:.0}° from the force), peak pressure {:.1} MPa; {b}; bore A's diameter changes {:+.2} µm along the force, {:+.2} µm across; radial clearances {:.1} / {:.1} µm",
         crate::rod::cases::label(&case.name),
+        match k.pins {
+            crate::rod::pin_model::PinModel::Rigid => "",
+            crate::rod::pin_model::PinModel::Elastic => " (elastic pins held at a rigid core)",
+            crate::rod::pin_model::PinModel::ElasticEnds =>
+                " (elastic pins held at the bore's faces)",
+        },
         k.arc_a_deg,
         k.arc_a_ends_deg[0],
         k.arc_a_ends_deg[1],

@@ -25,6 +25,7 @@ use crate::fem::element::QuadratureChoice;
 
 use super::bores::{BoreSpec, BoreSurface, default_clearance_m};
 use super::cases::{CaseDirection, STATIC_CASES};
+use super::pin_model::PinModel;
 use super::records::PinContactRecord;
 use crate::fem::contact::{
     ContactProblem, ContactSolution, ContactTolerances, Cylinder, PinElasticity, PinMotion,
@@ -123,6 +124,7 @@ impl ContactCase {
         let m = solution.restraint.moment_nm;
         Ok(ContactCase {
             record: PinContactRecord {
+                pins: PinModel::Rigid,
                 clearance_a_um: clearances_m[0] * 1e6,
                 clearance_b_um: clearances_m[1] * 1e6,
                 arc_a_deg: a.arc_deg,
@@ -242,13 +244,15 @@ pub(super) fn contact_solutions(
         timings.solve_s += t.elapsed().as_secs_f64()
             - solution.timings.assembly_s
             - solution.timings.factorisation_s;
-        solves.push(ContactCase::new(
+        let mut case = ContactCase::new(
             mesh,
             &problem,
             &solution,
             [c_a, c_b],
             t.elapsed().as_secs_f64(),
-        )?);
+        )?;
+        case.record.pins = bores.pins;
+        solves.push(case);
     }
     let stats = SolveStats {
         dofs: n,

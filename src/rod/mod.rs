@@ -1,6 +1,6 @@
 //! The rod problem of stage 3 (SPEC "Stage 3 — FEM", thesis §5.3) on the tet10 kernel of
 //! [`crate::fem`]: the pin bores found on the mesh ([`bores`]), the load cases as data ([`cases`])
-//! and how a pin's force enters its bore ([`pin_load`]), their solve ([`solve`]) and records
+//! and how a pin's force enters its bore ([`pin_load`]) through rigid or elastic pins ([`pin_model`]), their solve ([`solve`]) and records
 //! ([`records`]), the judged region away from the fixed bore and sharp edges ([`judged`]), the half
 //! model of a mirror-symmetric rod ([`half_model`]), the geometry check on a smooth surface through an STL's vertices
 //! ([`smooth`]), what the facets say ([`facets`], [`small_fillets`], [`segment_grid`]), the adaptive

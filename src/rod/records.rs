@@ -186,6 +186,12 @@ impl LoadModelPeaks {
 /// change of diameter, the acceptance figures.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct PinContactRecord {
+    /// The pins: rigid (the default, not written) or elastic ([`crate::rod::pin_model::PinModel`]).
+    #[serde(
+        default,
+        skip_serializing_if = "crate::rod::pin_model::PinModel::is_rigid"
+    )]
+    pub pins: crate::rod::pin_model::PinModel,
     /// Radial clearances of pins A and B in their bores, µm (negative: interference).
     pub clearance_a_um: f64,
     pub clearance_b_um: f64,

@@ -14,9 +14,9 @@
 //! pressure p ≥ 0 pushes the wall away from the axis: the traction on the body is p e_r, and the
 //! body pushes the pin with −p e_r.
 
-use super::elastic_pin::PinElasticity;
 use crate::fem::boundary::{dot, norm};
 use crate::fem::error::{FemError, Result};
+use crate::fem::material::Material;
 
 /// How a pin moves.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -28,7 +28,28 @@ pub enum PinMotion {
     Force([f64; 3]),
 }
 
-/// A rigid cylinder pressing on a set of the body's boundary faces.
+/// Where an elastic pin is held.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PinHold {
+    /// At its core (the nodes at the inner radius): a solid pin's compliance under the pressure.
+    Core,
+    /// At its two end faces (the bore's faces): the pin also bends and shears between them.
+    Ends,
+}
+
+/// An elastic pin's material, hold and bore.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PinElasticity {
+    /// The pin's material.
+    pub material: Material,
+    /// Where it is held.
+    pub hold: PinHold,
+    /// Its inner radius (its bore, or its rigid core) over the wall's radius, in (0, 1).
+    pub inner_ratio: f64,
+}
+
+/// A cylinder pressing on a set of the body's boundary faces: rigid, or elastic
+/// ([`super::elastic_pin`]).
 #[derive(Clone, Debug)]
 pub struct Cylinder {
     /// A point on the axis, m.
@@ -47,7 +68,7 @@ pub struct Cylinder {
     pub nominal_bore_radius_m: Option<f64>,
     /// Fixed or force-driven.
     pub motion: PinMotion,
-    /// `None`: the pin is rigid; else its elasticity ([`super::elastic_pin`]).
+    /// `None`: the pin is rigid; else its elasticity.
     pub elastic: Option<PinElasticity>,
 }
 

@@ -29,36 +29,15 @@
 use std::collections::HashMap;
 use std::sync::Mutex;
 
-use super::cylinder::{Cylinder, PinMotion};
-use super::system::Factorised;
+use super::cylinder::{Cylinder, PinElasticity, PinHold, PinMotion};
+use super::factorised::Factorised;
 use super::weights::Wall;
 use crate::fem::assembly::DofMap;
 use crate::fem::boundary::dot;
 use crate::fem::element::QuadratureChoice;
 use crate::fem::error::{FemError, Result};
-use crate::fem::material::Material;
 use crate::fem::mesh::TetMesh;
 use crate::fem::shape::TET10_EDGES;
-
-/// Where an elastic pin is held.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum PinHold {
-    /// At its core (the nodes at the inner radius): a solid pin's compliance under the pressure.
-    Core,
-    /// At its two end faces (the bore's faces): the pin also bends and shears between them.
-    Ends,
-}
-
-/// An elastic pin's material, hold and bore.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PinElasticity {
-    /// The pin's material.
-    pub material: Material,
-    /// Where it is held.
-    pub hold: PinHold,
-    /// Its inner radius (its bore, or its rigid core) over the wall's radius, in (0, 1).
-    pub inner_ratio: f64,
-}
 
 /// Growth of the layers' thickness from the wall inwards.
 const GROWTH: f64 = 1.5;
@@ -220,7 +199,7 @@ fn extrude(
         s[k + 1] = s[k] + GROWTH.powi(k as i32) / total;
     }
     let frac = |l: usize| {
-        if l % 2 == 0 {
+        if l.is_multiple_of(2) {
             s[l / 2]
         } else {
             0.5 * (s[l / 2] + s[l / 2 + 1])

@@ -24,6 +24,7 @@ pub mod check;
 pub mod compliance;
 pub mod cylinder;
 pub mod elastic_pin;
+pub mod factorised;
 pub mod lcp;
 pub mod measures;
 pub mod modes;
@@ -35,8 +36,7 @@ pub mod weights;
 
 pub use acceptance::ContactCheck;
 pub use check::check;
-pub use cylinder::{Cylinder, PinMotion};
-pub use elastic_pin::{PinElasticity, PinHold};
+pub use cylinder::{Cylinder, PinElasticity, PinHold, PinMotion};
 pub use measures::{DiameterChange, diameter_change};
 pub use problem::{
     ContactProblem, ContactSolution, ContactTimings, ContactTolerances, CylinderContact, Restraint,
