@@ -261,6 +261,8 @@ fn the_two_eye_plate_on_two_elastic_pins_against_calculix() {
             "0.2",
             "--pin-radial",
             "3",
+            "--pin-overhang",
+            "0",
         ],
     );
     let a = &peer["bore_a"];
