@@ -1,4 +1,4 @@
-//! Verification of linear buckling (issue 20, item 4): the smallest positive λ of
+//! Verification of linear buckling: the smallest positive λ of
 //! (K + λ K_σ) φ = 0 ([`rodstudy::fem::buckling`]).
 //!
 //! 1. A slender prismatic column, fixed at one end and loaded in compression at the other,

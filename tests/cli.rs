@@ -109,7 +109,7 @@ fn missing_paths_and_interpreters_are_clear_errors() {
     );
 }
 
-/// Issue 13 item 2: the default step cap grows with the simulated time, so a 100 s run at
+/// The default step cap grows with the simulated time, so a 100 s run at
 /// 1e-12 (9.1 million RK45 steps, more than the old fixed cap of a million) finishes; an explicit
 /// `--max-steps` is still a total and stops it with the step-limit message.
 #[test]
@@ -125,7 +125,7 @@ fn long_free_run_finishes_under_the_default_cap() {
     assert_eq!(v["t_end_s"].as_f64(), Some(100.0));
     // φ(100 s) against the energy-integral reference (independent of the integrator): φ reaches
     // 1.8e5 rad; 9.1e6 steps with plain sums of the increments measured 4.8e-4 rad (2.7e-9 of
-    // φ), with the compensated sum and φ as turns + remainder (issue 21) 1.19e-4 rad (6.6e-10
+    // φ), with the compensated sum and φ as turns + remainder 1.19e-4 rad (6.6e-10
     // of φ), the truncation error left by rtol 1e-12 (1.8e-7 rad per step at the end)
     let err = v["max_err_phi_rad"].as_f64().unwrap();
     let phi = v["phi_rad"].as_f64().unwrap();
@@ -140,7 +140,7 @@ fn long_free_run_finishes_under_the_default_cap() {
     assert!(msg.contains("step limit of 1000000 steps"), "{msg}");
 }
 
-/// Issue 21 item 1: `dynamics free --project-energy` reports its projections in the JSON
+/// `dynamics free --project-energy` reports its projections in the JSON
 /// (`energy_projection`), agrees with the exact reference, and is refused with another method.
 #[test]
 fn free_run_with_the_energy_projection() {
@@ -317,7 +317,7 @@ fn a_drifting_rk45_run_is_pointed_to_the_energy_projection() {
     );
 }
 
-/// Issue 13 item 1: `rodstudy mass` gives the mass properties of any closed solid; without bores
+/// `rodstudy mass` gives the mass properties of any closed solid; without bores
 /// at the pins the mechanism-frame fields are null with a warning, and the study still refuses it.
 #[test]
 fn mass_of_a_plain_box_without_bores() {

@@ -40,7 +40,7 @@ fn assert_methods_agree(
         "rod {rod:?}, gravity {}: {a:?}",
         params.gravity
     );
-    // each refines its peak on its own model (issue 13 item 3): they agree to the same tolerance
+    // each refines its peak on its own model: they agree to the same tolerance
     assert!(
         (test.peak_pin_force_n - reference.peak_pin_force_n).abs()
             <= tol * reference.peak_pin_force_n,

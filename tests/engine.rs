@@ -1,4 +1,4 @@
-//! The engine (issue 20 items 1–2): the `[engine]` settings and the pressure trace, the gas force
+//! The engine: the `[engine]` settings and the pressure trace, the gas force
 //! in both solution methods over the four-stroke cycle, the quasi-static statics of the slider,
 //! the example configuration, and that the default stays the thesis' rig.
 
@@ -52,7 +52,7 @@ fn unknown_keys_and_wrong_types_are_refused() {
     assert!(e.contains("engine.cylinder_bore_mm"), "{e}");
 }
 
-/// Reference: the trace rules of issue 20 item 1 (cover 0–720, monotone angles, no negative
+/// Reference: the pressure trace's rules (cover 0–720, monotone angles, no negative
 /// absolute pressure), each message naming the file and the line.
 #[test]
 fn bad_traces_are_refused_naming_file_and_line() {
@@ -95,7 +95,7 @@ fn bad_traces_are_refused_naming_file_and_line() {
     assert!(e.contains("nowhere.csv"), "{e}");
 }
 
-/// Reference: issue 20 item 1, "a relative path is relative to the config file".
+/// Reference: the `[engine]` settings: "a relative path is relative to the config file".
 #[test]
 fn a_relative_trace_path_is_resolved_against_the_config_folder() {
     let dir = tempdir("relative");
@@ -325,7 +325,7 @@ fn rodstudy(args: &[&str]) -> std::process::Output {
         .expect("runs")
 }
 
-/// Reference: issue 20 item 2 (the new fields) and the example's physics: 64 bar on an 82 mm
+/// Reference: the `[engine]` fields and the example's physics: 64 bar on an 82 mm
 /// bore is 33.7 kN of gas force, so tens of kN of compression; the tension is the inertia at
 /// exhaust top dead centre (360°), about the thesis' 7 kN.
 #[test]
@@ -456,7 +456,7 @@ fn cycle_json(config: Option<&Path>, out: &Path) -> serde_json::Value {
     serde_json::from_slice(&run.stdout).unwrap()
 }
 
-/// Reference: issue 20 item 5 (the cycle over 720° with the gas force; Gerber as a choice) and
+/// Reference: the cycle over 720° with the gas force (Gerber as a choice) and
 /// item 3 (the cosine bore load in the cycle). The gas force's peak is the trace's 64 bar on
 /// the 82 mm bore; equilibrium at B holds to round-off with the gas force too; the worst instant
 /// is at firing; the fatigue factor falls from today's (inertia only) to single digits; Gerber
@@ -521,7 +521,7 @@ fn the_engine_cycle_spans_720_degrees_with_the_gas_force() {
     );
 }
 
-/// Reference: the engine study's stage 3 (SPEC stage 3 refined by issue 20): the F_x case carries
+/// Reference: the engine study's stage 3 (SPEC stage 3): the F_x case carries
 /// the peak pin force, the F_y case the largest pin force across the rod over the cycle (the gas
 /// force acts along the rod), which the dynamics reports as `peak_transverse_n`.
 #[test]

@@ -804,7 +804,7 @@ fn design1_from_stl_end_to_end() {
 
 /// needs Python and designs/design5.stl: the surface stage 3 hands to gmsh (rod frame, simplified)
 /// meshed at 8 mm, where every classification of the ladder fails ("overlapping facets" where the
-/// slender shank's sliver faces meet the eyes, issue 18 item 5): the mesher's fallback "local
+/// slender shank's sliver faces meet the eyes): the mesher's fallback "local
 /// refinement" makes the mesh and says so, the mesh keeps the STL's exact volume (`mass`) within
 /// 0.2 % (measured -0.09 %; the usual 8 mm meshes of designs 1-4: +0.03 to +0.12 %), and the FEM
 /// finds both bores with the design's radii.

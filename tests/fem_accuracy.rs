@@ -1,4 +1,4 @@
-//! Stage 3 accuracy end to end (issue 10): the stress does not depend on the units or the pose of
+//! Stage 3 accuracy end to end: the stress does not depend on the units or the pose of
 //! the export, and the adaptive loop reaches a converged reference within its target.
 //!
 //! References: the same rod in millimetres as the one to compare with (units, pose); for the
@@ -307,7 +307,7 @@ fn fillet_rod(args: &[&str]) {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
-/// Issue 18 item 4: the fillet test rod exported as a CAD system tessellates by chord alone (24
+/// The fillet test rod exported as a CAD system tessellates by chord alone (24
 /// facets per turn, 15° kinks on the R8 fillets, the flat shank faces in two triangles each,
 /// fillet strips 40 mm long). Adaptive refinement reaches the peak with elements of the fillet's
 /// facet spacing (the huge flat triangles beside it set no floor there); the geometry part of the
@@ -418,7 +418,7 @@ fn against_reference(refs: &serde_json::Value, id: &str, case: &str, peak: f64) 
     ((peak - reference).abs() / reference, reference, uncertainty)
 }
 
-/// Issue 21: the judged F_y peak of each committed design, as `cargo run --release -- study`
+/// The judged F_y peak of each committed design, as `cargo run --release -- study`
 /// wrote it into `reports/results.json` (which CI regenerates and compares byte for byte), is
 /// honest against the design's exact geometry: curved tet10 on the calibrated B-rep refined to
 /// 1 % (`make_designs.py --step`, `tests/data/design_references.json`). The true error is within
@@ -450,7 +450,7 @@ fn the_committed_reports_agree_with_the_exact_geometry() {
     }
 }
 
-/// Issue 21 item 3: designs 4 and 5 through the adaptive loop as the study runs it (the half
+/// Designs 4 and 5 through the adaptive loop as the study runs it (the half
 /// model, the grid convergence index on three meshes), against their exact geometry. Design 4's
 /// F_y peak sits on a slot-end R4 fillet faceted at 10° whose facet floor (0.7 mm) the loop
 /// reaches on its third mesh; design 5's had the largest true / estimated of the five. Both

@@ -344,7 +344,7 @@ fn non_positive_reduced_inertia_is_refused_naming_phi() {
     }
 }
 
-/// Issue 21: over 100 s (φ → 1.8e5 rad, 29 000 turns) the error against the energy-integral
+/// Over 100 s (φ → 1.8e5 rad, 29 000 turns) the error against the energy-integral
 /// reference falls with the tolerance instead of being set by round-off. RK45 at atol 1e-10
 /// (rtol 0) measured max |Δφ| = 1.087e-5 rad on this 0.01 s grid (1.0895e-5 on the CLI's
 /// 1e-4 s grid; 8.917e-6 rad at 100 s, a step point), max |Δφ̇| = 1.452e-2 rad/s,
@@ -399,7 +399,7 @@ fn long_run_100s_error_falls_with_the_tolerance() {
     );
 }
 
-/// Issue 21 item 1: with the energy projection (`--project-energy`: φ̇ put back onto the
+/// With the energy projection (`--project-energy`: φ̇ put back onto the
 /// energy integral at the step's φ after every step, `EnergyProjection`) the drift that sets
 /// the error above is gone, and RK45 at atol 1e-10 ends well within 1e-6 rad of the exact φ
 /// over 100 s, at the same step count: measured max |Δφ| 6.2e-9 rad on the CLI's 1e-4 s grid
@@ -461,7 +461,7 @@ fn the_energy_projection_is_refused_where_it_does_not_apply() {
     assert!(e.contains("conservative"), "{e}");
 }
 
-/// Issue 21: the energy-integral reference itself is far more accurate than the errors it
+/// The energy-integral reference itself is far more accurate than the errors it
 /// measures at 100 s: a 10× looser panel threshold moves it by at most 1.6e-9 rad
 /// (measured 1.57e-9 rad, 2.0e-10 rad at 100 s), against RK45's 1.1e-5 rad at atol 1e-10.
 #[test]
@@ -475,7 +475,7 @@ fn long_run_100s_reference_is_converged() {
     assert!(dp < 3e-9 && dw < 4e-6, "{dp:e} {dw:e}");
 }
 
-/// Issue 21: a tolerance below what f64 resolves is raised to the floor κ·ε·|y_i| with a
+/// A tolerance below what f64 resolves is raised to the floor κ·ε·|y_i| with a
 /// warning, and the run stays cheap and accurate instead of fighting round-off: RK45 at atol
 /// 1e-16 over 1 s measured 5,785 steps (floored on 5,766), 5 rejected, max |Δφ| = 1.4e-14 rad
 /// (at 1e-12: 2,104 steps, 8.2e-13 rad).

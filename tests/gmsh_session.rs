@@ -188,7 +188,7 @@ fn a_failed_request_ends_the_session_with_the_reason() {
     assert!(err.contains("the gmsh session has ended"), "{err}");
 }
 
-/// Issue 21, session 29: gmsh hands HXT the surface vertices in the order of their memory
+/// gmsh hands HXT the surface vertices in the order of their memory
 /// addresses, and HXT's optimiser broke its ties by it, so one session meshing the same request
 /// again (after other meshes, with other paths) could make another mesh: design 5's third
 /// adaptive mesh (its half model) came out with 12,228 or 12,229 nodes, and a fresh clone in

@@ -1,4 +1,4 @@
-//! STEP designs (issue 18 item 1): exact B-rep mass properties against closed forms (a box, a
+//! STEP designs: exact B-rep mass properties against closed forms (a box, a
 //! cylinder) and against OpenCASCADE's own integrals of the foreign rods
 //! (`pipeline/foreign_rods.py`); pins found on the STEP's triangulation; a capless rod, a rod with
 //! its cap as a second solid, an inch STEP and a rod with its pins along y through the whole
@@ -372,7 +372,7 @@ fn foreign_rods_through_the_study() {
 /// (true / estimated error ≤ 2); F_x, whose target is relative to F_y's peak, honest too. The
 /// STEP's error bar has no geometry part. Then the STL of the same rod at a coarse chord
 /// tolerance (24 facets per turn: 15° kinks on the R8 fillets), refined the same way: its bar,
-/// which carries the geometry part (issue 18 item 4), is wider than the STEP's, holds the STEP's
+/// which carries the geometry part, is wider than the STEP's, holds the STEP's
 /// peak (the two bars together) and the reference (true / estimated ≤ 2).
 #[test]
 fn curved_tet10_on_the_step_fillet_rod() {
@@ -511,7 +511,7 @@ fn curved_tet10_on_the_step_fillet_rod() {
     }
 }
 
-/// Issue 18 item 5: the stepped foreign rod has an R1 fillet on every re-entrant edge. Its chord
+/// The stepped foreign rod has an R1 fillet on every re-entrant edge. Its chord
 /// export cuts each into two facets (45° kinks, above the 40° feature angle): they are fillets,
 /// not sharp edges, so nothing is excluded, the F_x peak is judged on the step fillet where the
 /// shank's faces meet the big eye (r = 45 mm, z = ±8 mm), and the error bar says that the
