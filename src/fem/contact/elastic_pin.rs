@@ -27,7 +27,6 @@
 //! outputs report.
 
 use std::collections::HashMap;
-use std::sync::Mutex;
 
 use super::cylinder::{Cylinder, PinElasticity, PinHold, PinMotion};
 use super::factorised::Factorised;
@@ -44,13 +43,13 @@ const GROWTH: f64 = 1.5;
 /// The most layers through the pin's wall.
 const MAX_LAYERS: usize = 12;
 
-/// A pin's compliance on its wall's rows, factorised once; columns computed once and kept.
+/// A pin's compliance on its wall's rows, factorised once (the body's
+/// [`super::system::ContactSystem`] keeps the columns it asks for).
 pub struct ElasticPin {
     mesh: TetMesh,
     wall: Wall,
     dofs: DofMap,
     fact: Factorised,
-    columns: Mutex<HashMap<usize, Vec<f64>>>,
 }
 
 /// A node of the pin: a wall node `a` at level `l` (0 the wall, 2 N the inner radius; odd levels
@@ -102,7 +101,6 @@ impl ElasticPin {
             wall: pin_wall,
             dofs,
             fact,
-            columns: Mutex::new(HashMap::new()),
         })
     }
 
@@ -113,19 +111,7 @@ impl ElasticPin {
 
     /// The columns S_p[:, j] (over the wall's rows) of the wall's rows `js`.
     pub fn columns(&self, js: &[usize]) -> Vec<Vec<f64>> {
-        let mut cache = self.columns.lock().unwrap_or_else(|e| e.into_inner());
-        let missing: Vec<usize> = js
-            .iter()
-            .copied()
-            .filter(|j| !cache.contains_key(j))
-            .collect();
-        if !missing.is_empty() {
-            let cols = self.fact.compliance.columns(&self.fact.factor, &missing);
-            for (j, col) in missing.iter().zip(cols) {
-                cache.insert(*j, col);
-            }
-        }
-        js.iter().map(|j| cache[j].clone()).collect()
+        self.fact.compliance.columns(&self.fact.factor, js)
     }
 
     /// The pin surface's displacement towards its axis at each wall node under the wall
@@ -286,8 +272,12 @@ fn extrude(
             }
         }
     }
-    let mesh = TetMesh::new(nodes, elements)
-        .map_err(|e| FemError::InvalidMesh(format!("elastic pin: its extruded mesh: {e}")))?;
+    let mesh = TetMesh::new(nodes, elements).map_err(|e| {
+        FemError::InvalidMesh(format!(
+            "elastic pin: the mesh extruded from the bore wall is not valid ({e}); use rigid \
+                 pins (`[fem] pins = \"rigid\"`) for this bore"
+        ))
+    })?;
     Ok((mesh, sources, levels))
 }
 
