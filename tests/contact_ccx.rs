@@ -90,8 +90,9 @@ fn ccx(mesh: &Path, extra: &[&str]) -> serde_json::Value {
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
-#[test]
-fn the_two_eye_plate_on_two_pins_against_calculix() {
+/// The test's plate (96 curved elements of 3.75° around each bore, 2 layers) and a folder
+/// holding it as `plate.rodmesh`.
+fn plate() -> (rodstudy::fem::TetMesh, tempfile::TempDir) {
     let plate = TwoEyePlate {
         curved: true,
         n_side: 24,
@@ -102,8 +103,14 @@ fn the_two_eye_plate_on_two_pins_against_calculix() {
     };
     let mesh = two_eye_plate(&plate).unwrap();
     let dir = tempfile::tempdir().unwrap();
+    write_rodmesh(&mesh, &dir.path().join("plate.rodmesh")).unwrap();
+    (mesh, dir)
+}
+
+#[test]
+fn the_two_eye_plate_on_two_pins_against_calculix() {
+    let (mesh, dir) = plate();
     let file = dir.path().join("plate.rodmesh");
-    write_rodmesh(&mesh, &file).unwrap();
     let pins = PinContact {
         force_n: [FORCE_N, 0.0, 0.0],
         clearance_a_m: CLEARANCE_M,
@@ -216,18 +223,8 @@ fn the_two_eye_plate_on_two_pins_against_calculix() {
 /// within 1 %, each end of the arc inside ccx's end face.
 #[test]
 fn the_two_eye_plate_on_two_elastic_pins_against_calculix() {
-    let plate = TwoEyePlate {
-        curved: true,
-        n_side: 24,
-        n_radial: 2,
-        n_shank: 4,
-        n_z: 2,
-        ..TwoEyePlate::default()
-    };
-    let mesh = two_eye_plate(&plate).unwrap();
-    let dir = tempfile::tempdir().unwrap();
+    let (mesh, dir) = plate();
     let file = dir.path().join("plate.rodmesh");
-    write_rodmesh(&mesh, &file).unwrap();
     let elastic = PinElasticity {
         material: Material::STEEL,
         hold: PinHold::Core,
